@@ -1,0 +1,1 @@
+//! Neighbour search (k-d tree with a brute-force reference), mutual nearest neighbours, assignment.

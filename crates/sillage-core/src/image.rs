@@ -1,0 +1,121 @@
+//! Owned row-major image buffers. Frames travel as [`GrayImage`]: grey levels in `[0, 1]`.
+
+use crate::{Error, Result};
+
+/// A row-major image of `width × height` pixels of type `T`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Image<T> {
+    width: usize,
+    height: usize,
+    data: Vec<T>,
+}
+
+/// A grey-level frame as `f32`, normalised so that the sensor's full scale is 1 (8-bit values
+/// are divided by 255, 16-bit by 65535).
+pub type GrayImage = Image<f32>;
+
+impl<T: Copy + Default> Image<T> {
+    /// A `width × height` image filled with `T::default()`.
+    pub fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            data: vec![T::default(); width * height],
+        }
+    }
+
+    /// Wraps `data` (row-major, `width × height` values).
+    pub fn from_vec(width: usize, height: usize, data: Vec<T>) -> Result<Self> {
+        if data.len() != width * height {
+            return Err(Error::input(format!(
+                "an image of {width}×{height} pixels needs {} values, got {}",
+                width * height,
+                data.len()
+            )));
+        }
+        Ok(Self {
+            width,
+            height,
+            data,
+        })
+    }
+
+    /// Re-shapes this buffer to `width × height`, keeping its allocation when it is large
+    /// enough (so per-frame buffers are reused). Pixel values are unspecified afterwards.
+    pub fn reshape(&mut self, width: usize, height: usize) {
+        self.width = width;
+        self.height = height;
+        self.data.resize(width * height, T::default());
+    }
+
+    /// Width in pixels (number of columns).
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in pixels (number of rows).
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// `(width, height)`.
+    pub fn dimensions(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// All pixels, row-major.
+    pub fn as_slice(&self) -> &[T] {
+        &self.data
+    }
+
+    /// All pixels, row-major, mutable.
+    pub fn as_mut_slice(&mut self) -> &mut [T] {
+        &mut self.data
+    }
+
+    /// The pixel buffer, consumed.
+    pub fn into_vec(self) -> Vec<T> {
+        self.data
+    }
+
+    /// Row `y`.
+    pub fn row(&self, y: usize) -> &[T] {
+        &self.data[y * self.width..(y + 1) * self.width]
+    }
+
+    /// Row `y`, mutable.
+    pub fn row_mut(&mut self, y: usize) -> &mut [T] {
+        &mut self.data[y * self.width..(y + 1) * self.width]
+    }
+
+    /// Pixel at column `x`, row `y`.
+    pub fn get(&self, x: usize, y: usize) -> T {
+        self.data[y * self.width + x]
+    }
+
+    /// Sets the pixel at column `x`, row `y`.
+    pub fn set(&mut self, x: usize, y: usize, value: T) {
+        self.data[y * self.width + x] = value;
+    }
+
+    /// True when the image has no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn indexing_is_row_major() {
+        let mut im = GrayImage::new(3, 2);
+        im.set(2, 1, 0.5);
+        assert_eq!(im.as_slice()[5], 0.5);
+        assert_eq!(im.row(1), &[0.0, 0.0, 0.5]);
+        assert!(Image::<u8>::from_vec(2, 2, vec![0; 3]).is_err());
+        im.reshape(1, 1);
+        assert_eq!(im.dimensions(), (1, 1));
+    }
+}

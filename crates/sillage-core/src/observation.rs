@@ -1,0 +1,94 @@
+//! What flows through the pipeline: detections in, track points out, truth beside.
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Point2, Vec2};
+
+/// 0-based index of a frame in its sequence.
+pub type FrameIndex = u64;
+
+/// Identity of a trajectory; unique within one run, never reused.
+pub type TrackId = u64;
+
+/// One object found in one frame by a detector.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Detection {
+    /// Sub-pixel centre, px.
+    pub pos_px: Point2,
+    /// Detector response at the centre (filtered intensity, NCC score, ...): larger is surer.
+    pub strength: f32,
+}
+
+impl Detection {
+    /// A detection at `pos_px` with response `strength`.
+    pub const fn new(pos_px: Point2, strength: f32) -> Self {
+        Self { pos_px, strength }
+    }
+}
+
+/// Motion state of an object (the bedload states of the MMPF+ paper; `Unknown` elsewhere).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MotionState {
+    /// Not estimated, or not yet known.
+    #[default]
+    Unknown,
+    /// At rest on the bed.
+    Resting,
+    /// Rolling on the bed surface.
+    Rolling,
+    /// In a ballistic hop.
+    Saltating,
+}
+
+/// One final point of one trajectory, as a tracker emits it.
+///
+/// Kinematic fields are `None` where the tracker does not estimate them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrackPoint {
+    /// Frame of this point.
+    pub frame: FrameIndex,
+    /// Trajectory identity.
+    pub track_id: TrackId,
+    /// Position, px.
+    pub pos_px: Point2,
+    /// Velocity, px/frame (PTV: central difference, Eq. (6) of the TracTrac paper).
+    pub vel_px_per_frame: Option<Vec2>,
+    /// Acceleration, px/frame² (PTV: Eq. (7)).
+    pub acc_px_per_frame2: Option<Vec2>,
+    /// Velocity predicted by the motion model, px/frame (PTV: Eq. (8)).
+    pub vel_pred_px_per_frame: Option<Vec2>,
+    /// log10 of the prediction error in px (PTV: Eq. (10), Chebyshev norm as TracTrac's code).
+    pub log10_pred_err: Option<f64>,
+    /// Estimated motion state.
+    pub motion_state: MotionState,
+}
+
+impl TrackPoint {
+    /// A point with only a position (kinematics unknown).
+    pub const fn at(frame: FrameIndex, track_id: TrackId, pos_px: Point2) -> Self {
+        Self {
+            frame,
+            track_id,
+            pos_px,
+            vel_px_per_frame: None,
+            acc_px_per_frame2: None,
+            vel_pred_px_per_frame: None,
+            log10_pred_err: None,
+            motion_state: MotionState::Unknown,
+        }
+    }
+}
+
+/// One point of a ground-truth trajectory.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TruthPoint {
+    /// Frame of this point.
+    pub frame: FrameIndex,
+    /// Identity of the true object.
+    pub track_id: TrackId,
+    /// True position, px.
+    pub pos_px: Point2,
+    /// True displacement to the next frame, px/frame, when known.
+    pub vel_px_per_frame: Option<Vec2>,
+}

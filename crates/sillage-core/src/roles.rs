@@ -1,0 +1,63 @@
+//! The role traits the pipeline is built from.
+
+use crate::{Detection, FrameIndex, GrayImage, Result, TrackPoint};
+
+/// Finds objects in one pre-processed frame.
+pub trait Detector {
+    /// Appends the detections of `image` to `out` (cleared first), reusing its allocation.
+    fn detect(&mut self, image: &GrayImage, out: &mut Vec<Detection>) -> Result<()>;
+}
+
+/// Everything a tracker may look at for one frame.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameObservations<'a> {
+    /// Index of the frame in the sequence.
+    pub frame: FrameIndex,
+    /// The detections of this frame.
+    pub detections: &'a [Detection],
+    /// The pre-processed frame, for trackers that weigh particles against pixels.
+    pub image: Option<&'a GrayImage>,
+    /// A detector-confidence map (MMPF+), when the detector makes one.
+    pub confidence: Option<&'a GrayImage>,
+}
+
+impl<'a> FrameObservations<'a> {
+    /// Observations made of detections only.
+    pub fn from_detections(frame: FrameIndex, detections: &'a [Detection]) -> Self {
+        Self {
+            frame,
+            detections,
+            image: None,
+            confidence: None,
+        }
+    }
+}
+
+/// Follows objects one frame at a time and emits each point once it is final.
+///
+/// A tracker may hold points back (PTV's three-frame association emits frame `t-1` at step
+/// `t`); [`Tracker::finish`] flushes what is left. Memory stays bounded whatever the length
+/// of the sequence.
+pub trait Tracker {
+    /// Consumes one frame; frames must come in increasing order.
+    fn step(
+        &mut self,
+        observations: &FrameObservations<'_>,
+        sink: &mut dyn TrackSink,
+    ) -> Result<()>;
+    /// Emits whatever is still held back; the tracker is done afterwards.
+    fn finish(&mut self, sink: &mut dyn TrackSink) -> Result<()>;
+}
+
+/// Receives final track points: a file writer, a collector, a metric.
+pub trait TrackSink {
+    /// Takes the points of one batch (typically one frame, in increasing track id order).
+    fn accept(&mut self, points: &[TrackPoint]) -> Result<()>;
+}
+
+impl TrackSink for Vec<TrackPoint> {
+    fn accept(&mut self, points: &[TrackPoint]) -> Result<()> {
+        self.extend_from_slice(points);
+        Ok(())
+    }
+}

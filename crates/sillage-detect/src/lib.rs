@@ -1,0 +1,1 @@
+//! Detectors built from sillage-image: DoG/LoG blob detection with sub-pixel refinement.

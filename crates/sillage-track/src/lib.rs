@@ -1,0 +1,1 @@
+//! Trackers: PTV (TracTrac-class three-frame association with a local-flow predictor).

@@ -1,0 +1,1 @@
+//! Facade of the sillage toolkit: re-exports and the pipeline built from one configuration.
