@@ -1,1 +1,30 @@
-fn main() {}
+//! `sillage`: the command line of the sillage tracking toolkit.
+//!
+//! Exit codes: 0 on success, 1 on a user error (the message names the file, line or frame and
+//! the fix), 2 on a bad command line.
+
+mod bench;
+mod cli;
+mod demo;
+mod eval;
+mod progress;
+mod ptv;
+mod synth;
+
+use clap::Parser;
+
+fn main() {
+    let args = cli::Cli::parse();
+    let outcome = match args.command {
+        cli::Command::Ptv(a) => ptv::run(&a),
+        cli::Command::Synth(cli::SynthCommand::Vortex(a)) => synth::run_vortex(&a),
+        cli::Command::Eval(cli::EvalCommand::Ptv(a)) => eval::run_ptv(&a),
+        cli::Command::Demo(a) => demo::run(&a),
+        cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
+        cli::Command::Config(a) => ptv::print_config(&a),
+    };
+    if let Err(error) = outcome {
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}

@@ -11,12 +11,12 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[non_exhaustive]
 pub enum Error {
     /// A file or folder could not be opened, read or written.
-    #[error("{}: {source}{}", path.display(), hint_suffix(hint))]
+    #[error("{}: {cause}{}", path.display(), hint_suffix(hint))]
     Io {
         /// The path involved.
         path: PathBuf,
-        /// The operating-system error.
-        source: std::io::Error,
+        /// The operating-system error (shown in the message, so not chained as a source).
+        cause: std::io::Error,
         /// What the user can do about it (may be empty).
         hint: String,
     },
@@ -77,10 +77,10 @@ fn hint_suffix(hint: &str) -> String {
 
 impl Error {
     /// An IO error on `path`, with no hint.
-    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+    pub fn io(path: impl Into<PathBuf>, cause: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),
-            source,
+            cause,
             hint: String::new(),
         }
     }

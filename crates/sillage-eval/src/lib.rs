@@ -1,1 +1,30 @@
-//! Metrics as pure functions of truth and estimate: PTV recovery indexes, detection recall/precision.
+//! Metrics as pure functions of truth and estimate: PTV recovery indexes, detection
+//! recall/precision.
+//!
+//! - [`ptv_accuracy`]: the four accuracy indexes of the TracTrac paper (§4.1.2, Fig. 4):
+//!   true and false recovery rates, mean position and displacement errors.
+//! - [`detection_scores`]: recall, precision and localisation error of a detector.
+//!
+//! Metrics only read their inputs; inputs need not be sorted.
+//!
+//! ```
+//! use sillage_core::{Point2, TrackPoint, TruthPoint, Vec2};
+//! use sillage_eval::{PtvAccuracyParams, ptv_accuracy};
+//! let v = Vec2::new(3.0, 4.0);
+//! let truth = [TruthPoint { frame: 1, track_id: 0, pos_px: Point2::new(10.0, 10.0), vel_px_per_frame: Some(v) }];
+//! let mut estimate = TrackPoint::at(1, 42, Point2::new(10.2, 10.0));
+//! estimate.vel_px_per_frame = Some(Vec2::new(3.0, 4.5));
+//! let accuracy = ptv_accuracy(&truth, &[estimate], &PtvAccuracyParams::default()).unwrap();
+//! assert_eq!(accuracy.true_recovery_rate, Some(1.0));
+//! assert_eq!(accuracy.false_recovery_rate, Some(0.0));
+//! assert!((accuracy.mean_position_error_px.unwrap() - 0.2).abs() < 1e-12);
+//! println!("{accuracy}");
+//! ```
+
+pub mod detection;
+mod matching;
+pub mod ptv;
+mod summary;
+
+pub use detection::{DetectionScores, detection_scores};
+pub use ptv::{PtvAccuracy, PtvAccuracyParams, ptv_accuracy};

@@ -1,1 +1,70 @@
-//! Frame sources (image folders, TIFF stacks, video via ffmpeg) and table readers/writers.
+//! Reading and writing everything that crosses the file system: frame sources (image
+//! folders, glob patterns, multi-page TIFF stacks, videos through the `ffmpeg` program),
+//! track tables (TracTrac `_track.txt`, CSV, Parquet, HDF5), ground truth and detections
+//! (CSV), and TracTrac parameter files.
+//!
+//! Roles:
+//! - [`open_frames`] turns an INPUT string into a [`FrameSource`], an iterator of
+//!   [`Frame`]s decoded ahead on a background thread (bounded memory);
+//! - [`create_track_writer`] gives a [`TrackWriter`], a [`sillage_core::TrackSink`] that
+//!   streams points into a file; [`read_tracks`] reads one back;
+//! - [`TruthCsvWriter`] / [`read_truth_csv`], [`DetectionsCsvWriter`] /
+//!   [`read_detections_csv`] for ground truth and saved detections;
+//! - [`read_tractrac_par`] / [`write_tractrac_par`] for TracTrac's `*_par.txt`.
+//!
+//! Every file is written as `.NAME.partial` in the destination folder and renamed when
+//! complete. Errors name the file, the line or frame, and the fix.
+//!
+//! ```
+//! use sillage_core::{Point2, TrackPoint, TrackSink};
+//! use sillage_io::{
+//!     FrameOptions, TrackFileHeader, TrackFormat, create_track_writer, open_frames,
+//!     read_tracks, write_png16,
+//! };
+//!
+//! # fn main() -> sillage_core::Result<()> {
+//! let dir = tempfile::tempdir().unwrap();
+//! // Two 16-bit frames, then read them back as a sequence.
+//! let mut image = sillage_core::GrayImage::new(8, 4);
+//! image.set(3, 2, 0.5);
+//! write_png16(dir.path().join("frame_1.png"), &image)?;
+//! write_png16(dir.path().join("frame_2.png"), &image)?;
+//! let frames = open_frames(dir.path().to_str().unwrap(), &FrameOptions::default())?;
+//! assert_eq!(frames.dimensions(), (8, 4));
+//! for frame in frames {
+//!     let frame = frame?;
+//!     assert!((frame.image.get(3, 2) - 0.5).abs() < 1e-4);
+//! }
+//!
+//! // Stream track points into a TracTrac `_track.txt`, then read them back.
+//! let path = dir.path().join("seq_track.txt");
+//! let mut writer = create_track_writer(&path, TrackFormat::Tractrac, &TrackFileHeader::default())?;
+//! writer.accept(&[TrackPoint::at(1, 7, Point2::new(3.25, 2.5))])?;
+//! let summary = writer.finish()?;
+//! assert_eq!(summary.rows, 1);
+//! let points = read_tracks(&path, TrackFormat::from_path(&path)?)?;
+//! assert_eq!(points[0].track_id, 7);
+//! # Ok(())
+//! # }
+//! ```
+
+mod detections;
+mod frames;
+mod partial;
+mod text_table;
+mod tracks;
+mod tractrac_par;
+mod truth;
+
+pub use detections::{
+    DETECTIONS_HEADER, DetectionsCsvWriter, read_detections_csv, write_detections_csv,
+};
+pub use frames::{Frame, FrameOptions, FrameSource, open_frames, read_image, write_png16};
+pub use tracks::{
+    TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackWriter,
+    WrittenSummary, create_track_writer, read_tracks,
+};
+pub use tractrac_par::{
+    TRACTRAC_KEYS, TractracPar, parse_tractrac_par, read_tractrac_par, write_tractrac_par,
+};
+pub use truth::{TRUTH_HEADER, TruthCsvWriter, read_truth_csv, write_truth_csv};

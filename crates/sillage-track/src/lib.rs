@@ -1,1 +1,29 @@
-//! Trackers: PTV (TracTrac-class three-frame association with a local-flow predictor).
+//! Trackers: one module per algorithm, each implementing [`sillage_core::Tracker`].
+//!
+//! - [`ptv`]: TracTrac-class particle tracking velocimetry — three-frame mutual
+//!   nearest-neighbour association with a local-flow motion model and an adaptive outlier
+//!   filter (Heyman, TracTrac, §3.1.2–3.1.4).
+//!
+//! ```
+//! use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker};
+//! use sillage_track::ptv::{PtvParams, PtvTracker};
+//!
+//! let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
+//! let mut points: Vec<TrackPoint> = Vec::new();
+//! for frame in 0..4u64 {
+//!     // Two particles moving right by 1.5 px/frame.
+//!     let detections: Vec<Detection> = [10.0, 50.0]
+//!         .iter()
+//!         .map(|&y| Detection::new(Point2::new(5.0 + 1.5 * frame as f64, y), 1.0))
+//!         .collect();
+//!     let observations = FrameObservations::from_detections(frame, &detections);
+//!     tracker.step(&observations, &mut points).unwrap();
+//! }
+//! tracker.finish(&mut points).unwrap();
+//! // Frames 1 and 2 are the middles of the two triplets.
+//! assert_eq!(points.len(), 4);
+//! assert_eq!(points[0].vel_px_per_frame.unwrap().x, 1.5);
+//! assert_eq!(points[0].track_id, points[2].track_id);
+//! ```
+
+pub mod ptv;

@@ -1,1 +1,34 @@
-//! Facade of the sillage toolkit: re-exports and the pipeline built from one configuration.
+//! sillage: follow many moving objects through image sequences.
+//!
+//! This facade re-exports the toolkit's crates and builds a whole pipeline from one
+//! [`PipelineConfig`]. It is the only crate that knows every detector and tracker.
+//!
+//! ```no_run
+//! use sillage::{Pipeline, PipelineConfig};
+//! use sillage::io::{open_frames, FrameOptions};
+//! use sillage::core::TrackPoint;
+//!
+//! let config = PipelineConfig::default();
+//! let mut pipeline = Pipeline::from_config(&config)?;
+//! let frames = open_frames("experiment/*.tif", &FrameOptions::default())?;
+//! let mut tracks: Vec<TrackPoint> = Vec::new();
+//! let summary = pipeline.run(frames, &mut tracks, &mut |_| {})?;
+//! println!("{} tracks over {} frames", summary.tracks, summary.frames);
+//! # Ok::<(), sillage::core::Error>(())
+//! ```
+
+pub mod config;
+pub mod pipeline;
+pub mod tractrac;
+
+pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
+pub use pipeline::{FrameReport, Pipeline, RunSummary};
+
+pub use sillage_assoc as assoc;
+pub use sillage_core as core;
+pub use sillage_detect as detect;
+pub use sillage_eval as eval;
+pub use sillage_image as image;
+pub use sillage_io as io;
+pub use sillage_synth as synth;
+pub use sillage_track as track;

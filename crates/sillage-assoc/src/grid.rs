@@ -1,0 +1,613 @@
+//! The fast index: a uniform grid (bucket grid) rebuilt in O(n) for every frame.
+//!
+//! Why a grid and not a k-d tree: PTV frames hold 10^3–10^5 particles seeded at a nearly
+//! uniform density, and several indexes are built per frame. A counting sort into cells of
+//! a few points builds in a fraction of the time of a k-d tree and answers nearest and
+//! 10-nearest queries by scanning a few neighbouring cells, without any tree descent;
+//! `benches/neighbours.rs` measures it against kiddo's `ImmutableKdTree`. The price:
+//! strongly clustered sets (most points in a few cells) degrade towards brute force, where
+//! a k-d tree would not.
+//!
+//! The algorithm is the classic cell-list ("bucketing") search of Bentley, Weide & Yao,
+//! *Optimal expected-time algorithms for closest point problems*, ACM TOMS 6(4), 1980:
+//! points are counting-sorted by cell into one contiguous structure-of-arrays (cell
+//! starts, then x, y and original index), so a run of cells of a grid row is one
+//! contiguous slice. A query visits its own cell, then its 8 neighbours nearest first, then
+//! square rings of cells of growing Chebyshev radius; it skips rows and cells that lie
+//! farther than the current k-th best distance, and stops as soon as every cell not yet
+//! visited is farther than it. The k best
+//! candidates are kept by insertion into a fixed array of k (no heap, no allocation for
+//! k ≤ 32).
+
+use rayon::prelude::*;
+use sillage_core::Point2;
+
+use crate::index::{Neighbour, NeighbourIndex};
+
+/// Default mean number of points per grid cell.
+const DEFAULT_OCCUPANCY: f64 = 2.0;
+
+/// Largest |cell coordinate| a query is mapped to, so ring arithmetic never overflows.
+const MAX_CELL_COORD: f64 = (1u64 << 40) as f64;
+
+/// Largest k whose candidate arrays live on the stack.
+const STACK_K: usize = 32;
+
+/// Queries per rayon task in [`PointIndex::map_k_nearest`].
+const CHUNK: usize = 256;
+
+/// The 8 cells around a query's cell, nearest first for a query in the upper-right
+/// quarter of its cell (offsets are mirrored for the other quarters).
+const NEIGHBOURS_BY_PROXIMITY: [(i64, i64); 8] = [
+    (1, 0),
+    (0, 1),
+    (1, 1),
+    (-1, 0),
+    (0, -1),
+    (-1, 1),
+    (1, -1),
+    (-1, -1),
+];
+
+/// Index meaning "no point" (never a valid index: an index holds fewer points).
+const NO_POINT: u32 = u32::MAX;
+
+/// Uniform-grid neighbour index over a set of points, with exact nearest and k-nearest
+/// queries (ties to the lower index).
+///
+/// Build it once per frame ([`PointIndex::new`]) or rebuild it in place
+/// ([`PointIndex::rebuild`], [`PointIndex::rebuild_concat`]) to reuse its memory from frame
+/// to frame. The cell size is chosen so that cells hold `occupancy` points on average over
+/// the bounding box. An index holds fewer than 2³² − 1 points.
+#[derive(Debug, Clone)]
+pub struct PointIndex {
+    occupancy: f64,
+    len: usize,
+    origin: Point2,
+    cell: f64,
+    inv_cell: f64,
+    slack: f64,
+    nx: usize,
+    ny: usize,
+    /// `starts[c]..starts[c + 1]` are the entries of cell `c = row * nx + column`.
+    starts: Vec<u32>,
+    /// Entries sorted by cell (structure of arrays): coordinates and original index.
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    ids: Vec<u32>,
+    /// Build scratch: the cell of every point (`NO_POINT` when not finite).
+    cell_of: Vec<u32>,
+}
+
+impl Default for PointIndex {
+    fn default() -> Self {
+        Self::with_occupancy(DEFAULT_OCCUPANCY)
+    }
+}
+
+impl PointIndex {
+    /// An index over `points` (two points per cell on average).
+    ///
+    /// # Panics
+    /// If `points` holds 2³² − 1 points or more.
+    pub fn new(points: &[Point2]) -> Self {
+        let mut index = Self::default();
+        index.rebuild(points);
+        index
+    }
+
+    /// An empty index whose cells will hold `points_per_cell` points on average (values
+    /// that are not finite and positive fall back to 2). About 2 suits nearest-neighbour
+    /// queries, about `k / 2` suits k-nearest queries.
+    pub fn with_occupancy(points_per_cell: f64) -> Self {
+        let occupancy = if points_per_cell.is_finite() && points_per_cell > 0.0 {
+            points_per_cell
+        } else {
+            DEFAULT_OCCUPANCY
+        };
+        Self {
+            occupancy,
+            len: 0,
+            origin: Point2::default(),
+            cell: 1.0,
+            inv_cell: 1.0,
+            slack: 0.0,
+            nx: 0,
+            ny: 0,
+            starts: vec![0],
+            xs: Vec::new(),
+            ys: Vec::new(),
+            ids: Vec::new(),
+            cell_of: Vec::new(),
+        }
+    }
+
+    /// Re-indexes `points`, keeping this index's allocations.
+    ///
+    /// # Panics
+    /// If `points` holds 2³² − 1 points or more.
+    pub fn rebuild(&mut self, points: &[Point2]) {
+        self.rebuild_parts(&[points]);
+    }
+
+    /// Re-indexes the concatenation of `first` and `second` without copying it: the points
+    /// of `second` get indexes `first.len()..`. Keeps this index's allocations.
+    ///
+    /// # Panics
+    /// If the two sets hold 2³² − 1 points or more together.
+    pub fn rebuild_concat(&mut self, first: &[Point2], second: &[Point2]) {
+        self.rebuild_parts(&[first, second]);
+    }
+
+    /// Indexes the concatenation of `parts`.
+    fn rebuild_parts(&mut self, parts: &[&[Point2]]) {
+        let len: usize = parts.iter().map(|p| p.len()).sum();
+        assert!(
+            len < NO_POINT as usize,
+            "a PointIndex holds fewer than 2^32 - 1 points (got {len})"
+        );
+        self.len = len;
+        self.cell_of.clear();
+        self.starts.clear();
+        let all = || parts.iter().flat_map(|p| p.iter());
+        let (lo, hi, n_finite) = bounding_box(all());
+        if n_finite == 0 {
+            self.nx = 0;
+            self.ny = 0;
+            self.starts.push(0);
+            self.xs.clear();
+            self.ys.clear();
+            self.ids.clear();
+            return;
+        }
+        self.layout(lo, hi, n_finite);
+        let n_cells = self.nx * self.ny;
+        let (nx, ny) = (self.nx as i64, self.ny as i64);
+        self.starts.resize(n_cells + 1, 0);
+        for p in all() {
+            let cell = if p.is_finite() {
+                let cx = self.cell_coord(p.x - lo.x).clamp(0, nx - 1) as usize;
+                let cy = self.cell_coord(p.y - lo.y).clamp(0, ny - 1) as usize;
+                let c = cy * self.nx + cx;
+                self.starts[c] += 1;
+                c as u32
+            } else {
+                NO_POINT
+            };
+            self.cell_of.push(cell);
+        }
+        // Counting sort: inclusive prefix sums give each cell's end; filling from the last
+        // point backwards moves every end down to its cell's start and keeps each cell's
+        // points in increasing index order.
+        let mut total = 0;
+        for s in &mut self.starts[..n_cells] {
+            total += *s;
+            *s = total;
+        }
+        self.starts[n_cells] = total;
+        let total = total as usize;
+        self.xs.resize(total, 0.0);
+        self.ys.resize(total, 0.0);
+        self.ids.resize(total, 0);
+        let mut end = len;
+        for part in parts.iter().rev() {
+            end -= part.len();
+            for (j, p) in part.iter().enumerate().rev() {
+                let index = end + j;
+                let c = self.cell_of[index];
+                if c != NO_POINT {
+                    let slot = &mut self.starts[c as usize];
+                    *slot -= 1;
+                    let at = *slot as usize;
+                    self.xs[at] = p.x;
+                    self.ys[at] = p.y;
+                    self.ids[at] = index as u32;
+                }
+            }
+        }
+    }
+
+    /// Chooses the cell size and grid shape for a box `lo..hi` holding `n` finite points.
+    fn layout(&mut self, lo: Point2, hi: Point2, n: usize) {
+        let (w, h) = (hi.x - lo.x, hi.y - lo.y);
+        let extent = w.max(h);
+        let nf = n as f64;
+        let max_cells = 4 * n + 16;
+        let mut cell = (w * h * self.occupancy / nf)
+            .sqrt()
+            .max(extent * self.occupancy / nf);
+        let (mut nx, mut ny) = (1, 1);
+        if cell.is_finite() && cell > 0.0 {
+            nx = (w / cell) as usize + 1;
+            ny = (h / cell) as usize + 1;
+        }
+        if !(cell.is_finite() && cell > 0.0) || nx.saturating_mul(ny) > max_cells {
+            // Degenerate box (one point repeated, or coordinates too large to subtract):
+            // a single cell, which the queries scan exhaustively.
+            (nx, ny) = (1, 1);
+            cell = f64::INFINITY;
+        }
+        self.origin = lo;
+        self.nx = nx;
+        self.ny = ny;
+        self.cell = cell;
+        self.inv_cell = if cell.is_finite() { 1.0 / cell } else { 0.0 };
+        // Rounding in the cell assignment can put a point a few ulps beyond its cell's
+        // walls; every distance bound is lowered by this much so the search stays exact.
+        let scale = lo.x.abs() + lo.y.abs() + hi.x.abs() + hi.y.abs();
+        self.slack = 1e-9 * (scale + if cell.is_finite() { cell } else { 0.0 });
+    }
+
+    /// Cell coordinate of an offset from the origin (unclamped, saturating).
+    #[inline]
+    fn cell_coord(&self, offset: f64) -> i64 {
+        // NaN maps to 0; the clamp keeps the truncation exact, and the truncation minus
+        // one for negative non-integers is the floor (without a libm call on baseline x86).
+        let c = (offset * self.inv_cell).clamp(-MAX_CELL_COORD, MAX_CELL_COORD);
+        if c.is_nan() {
+            return 0;
+        }
+        let t = c as i64;
+        t - i64::from(c < t as f64)
+    }
+
+    /// Lower bound on the distance along one axis from `p` to the slab of cells `c`
+    /// (walls at `origin + c·cell` and `origin + (c + 1)·cell`); 0 inside it, and 0 when
+    /// the walls are not finite (degenerate single-cell grid).
+    #[inline]
+    fn gap(&self, p: f64, origin: f64, c: i64) -> f64 {
+        let lo = origin + c as f64 * self.cell;
+        let hi = origin + (c + 1) as f64 * self.cell;
+        ((lo - p).max(p - hi) - self.slack).max(0.0)
+    }
+
+    /// Visits cells in square rings of growing Chebyshev radius around `p`'s cell, handing
+    /// their points to `visitor`. A row or cell of a ring is skipped when it lies farther
+    /// than the squared distance a point must beat, and the search stops when every cell
+    /// not yet visited does.
+    #[inline]
+    fn search(&self, p: Point2, visitor: &mut impl Visitor) {
+        if self.xs.is_empty() || !p.is_finite() {
+            return;
+        }
+        let (nx, ny) = (self.nx as i64, self.ny as i64);
+        let cx = self.cell_coord(p.x - self.origin.x);
+        let cy = self.cell_coord(p.y - self.origin.y);
+        let mut r_first = 0.max(-cx).max(cx - (nx - 1)).max(-cy).max(cy - (ny - 1));
+        let r_last = cx.max(nx - 1 - cx).max(cy).max(ny - 1 - cy);
+        if r_first == 0 {
+            // Inside the grid: the 3×3 block first, nearest cells first (own cell, then the
+            // neighbours on the query's side), so the k-th best tightens early and farther
+            // cells are skipped or rejected point by point without insertion.
+            let side = |p: f64, origin: f64, c: i64| {
+                if (p - origin) * self.inv_cell - c as f64 >= 0.5 {
+                    1
+                } else {
+                    -1
+                }
+            };
+            let (sx, sy) = (side(p.x, self.origin.x, cx), side(p.y, self.origin.y, cy));
+            let own = (cy * nx + cx) as usize;
+            self.visit_cells(own, own, visitor);
+            for (dx, dy) in NEIGHBOURS_BY_PROXIMITY {
+                let (x, y) = (cx + dx * sx, cy + dy * sy);
+                if (0..nx).contains(&x) && (0..ny).contains(&y) {
+                    let gx = self.gap(p.x, self.origin.x, x);
+                    let gy = self.gap(p.y, self.origin.y, y);
+                    if gx * gx + gy * gy <= visitor.worst_d2() {
+                        let c = (y * nx + x) as usize;
+                        self.visit_cells(c, c, visitor);
+                    }
+                }
+            }
+            if r_last <= 1 {
+                return;
+            }
+            let bound = self.unvisited_bound(p, cx, cy, 1);
+            if bound > 0.0 && visitor.worst_d2() < bound * bound {
+                return;
+            }
+            r_first = 2;
+        }
+        for r in r_first..=r_last {
+            let (x_lo, x_hi) = ((cx - r).max(0), (cx + r).min(nx - 1));
+            let (y_lo, y_hi) = ((cy - r).max(0), (cy + r).min(ny - 1));
+            for y in y_lo..=y_hi {
+                let row = (y * nx) as usize;
+                let gy = self.gap(p.y, self.origin.y, y);
+                let gy2 = gy * gy;
+                if gy2 > visitor.worst_d2() {
+                    continue;
+                }
+                if y == cy - r || y == cy + r {
+                    self.visit_cells(row + x_lo as usize, row + x_hi as usize, visitor);
+                } else {
+                    // Here r > 0, so the two side cells are distinct.
+                    for x in [cx - r, cx + r] {
+                        if (0..nx).contains(&x) {
+                            let gx = self.gap(p.x, self.origin.x, x);
+                            if gx * gx + gy2 <= visitor.worst_d2() {
+                                let c = row + x as usize;
+                                self.visit_cells(c, c, visitor);
+                            }
+                        }
+                    }
+                }
+            }
+            if r < r_last {
+                let bound = self.unvisited_bound(p, cx, cy, r);
+                if bound > 0.0 && visitor.worst_d2() < bound * bound {
+                    return;
+                }
+            }
+        }
+    }
+
+    /// Hands the points of cells `first..=last` (contiguous in storage) to `visitor`.
+    #[inline]
+    fn visit_cells(&self, first: usize, last: usize, visitor: &mut impl Visitor) {
+        let range = self.starts[first] as usize..self.starts[last + 1] as usize;
+        visitor.visit(
+            &self.xs[range.clone()],
+            &self.ys[range.clone()],
+            &self.ids[range],
+        );
+    }
+
+    /// Lower bound on the distance from `p` to any point outside the block of cells within
+    /// Chebyshev radius `r` of `(cx, cy)`; block sides at the grid's edge do not count.
+    fn unvisited_bound(&self, p: Point2, cx: i64, cy: i64, r: i64) -> f64 {
+        let (nx, ny) = (self.nx as i64, self.ny as i64);
+        let wall = |origin: f64, c: i64| origin + c as f64 * self.cell;
+        let mut bound = f64::INFINITY;
+        if cx - r > 0 {
+            bound = bound.min(p.x - wall(self.origin.x, cx - r));
+        }
+        if cx + r < nx - 1 {
+            bound = bound.min(wall(self.origin.x, cx + r + 1) - p.x);
+        }
+        if cy - r > 0 {
+            bound = bound.min(p.y - wall(self.origin.y, cy - r));
+        }
+        if cy + r < ny - 1 {
+            bound = bound.min(wall(self.origin.y, cy + r + 1) - p.y);
+        }
+        bound - self.slack
+    }
+
+    /// The `min(k, len)` nearest points of `p` as (index, squared distance), nearest
+    /// first, written to the front of `d2` / `ids` (both at least that long); returns how
+    /// many were found.
+    #[inline]
+    fn k_nearest_into(&self, p: Point2, d2: &mut [f64], ids: &mut [u32]) -> usize {
+        let mut best = KBest {
+            px: p.x,
+            py: p.y,
+            k: d2.len().min(ids.len()),
+            n: 0,
+            d2,
+            ids,
+            worst: f64::INFINITY,
+            worst_id: NO_POINT,
+        };
+        if best.k > 0 {
+            self.search(p, &mut best);
+        }
+        best.n
+    }
+
+    /// For every query, `f` of the indexes of its `min(k, len)` nearest points, nearest
+    /// first (ties to the lower index), in parallel; `out[i]` answers `queries[i]`. Same
+    /// neighbours as [`NeighbourIndex::k_nearest`], without the distances and without any
+    /// per-query allocation; `out` is overwritten and its allocation reused. The result
+    /// does not depend on the number of rayon threads.
+    pub fn map_k_nearest<T: Send + Default>(
+        &self,
+        queries: &[Point2],
+        k: usize,
+        out: &mut Vec<T>,
+        f: impl Fn(&[u32]) -> T + Sync,
+    ) {
+        out.clear();
+        out.resize_with(queries.len(), T::default);
+        let k = k.min(self.xs.len());
+        queries
+            .par_chunks(CHUNK)
+            .zip(out.par_chunks_mut(CHUNK))
+            .for_each(|(queries, out)| {
+                with_scratch(k, |d2, ids| {
+                    for (&q, o) in queries.iter().zip(out) {
+                        let n = self.k_nearest_into(q, d2, ids);
+                        *o = f(&ids[..n]);
+                    }
+                })
+            });
+    }
+}
+
+/// Runs `f` on candidate arrays of length `k`: on the stack when `k` ≤ [`STACK_K`].
+#[inline]
+fn with_scratch<R>(k: usize, f: impl FnOnce(&mut [f64], &mut [u32]) -> R) -> R {
+    if k <= STACK_K {
+        let (mut d2, mut ids) = ([0.0; STACK_K], [0; STACK_K]);
+        f(&mut d2[..k], &mut ids[..k])
+    } else {
+        f(&mut vec![0.0; k], &mut vec![0; k])
+    }
+}
+
+/// What a grid search collects.
+trait Visitor {
+    /// Offers the points of a run of cells (coordinates and original indexes).
+    fn visit(&mut self, xs: &[f64], ys: &[f64], ids: &[u32]);
+    /// Squared distance a point must not exceed to still matter.
+    fn worst_d2(&self) -> f64;
+}
+
+/// Collects the nearest point (ties to the lower index).
+struct Nearest {
+    px: f64,
+    py: f64,
+    d2: f64,
+    id: u32,
+}
+
+impl Visitor for Nearest {
+    #[inline]
+    fn visit(&mut self, xs: &[f64], ys: &[f64], ids: &[u32]) {
+        for ((&x, &y), &id) in xs.iter().zip(ys).zip(ids) {
+            // Computed as `index::dist2`, so that ties are exact.
+            let (dx, dy) = (self.px - x, self.py - y);
+            let d = dx * dx + dy * dy;
+            if d < self.d2 || (d == self.d2 && id < self.id) {
+                (self.d2, self.id) = (d, id);
+            }
+        }
+    }
+
+    #[inline]
+    fn worst_d2(&self) -> f64 {
+        self.d2
+    }
+}
+
+/// Collects the `k` nearest points, sorted by (squared distance, index), by insertion
+/// into fixed arrays.
+struct KBest<'a> {
+    px: f64,
+    py: f64,
+    k: usize,
+    n: usize,
+    d2: &'a mut [f64],
+    ids: &'a mut [u32],
+    /// The k-th best so far (infinite and `NO_POINT` until k are held).
+    worst: f64,
+    worst_id: u32,
+}
+
+impl KBest<'_> {
+    /// Inserts a candidate that ranks before the current k-th best (dropping that one when
+    /// k are held), shifting the worse ones up one slot.
+    #[inline]
+    fn insert(&mut self, d: f64, id: u32) {
+        let mut at = if self.n < self.k {
+            self.n += 1;
+            self.n - 1
+        } else {
+            self.k - 1
+        };
+        while at > 0 {
+            let (prev_d, prev_id) = (self.d2[at - 1], self.ids[at - 1]);
+            if d < prev_d || (d == prev_d && id < prev_id) {
+                self.d2[at] = prev_d;
+                self.ids[at] = prev_id;
+                at -= 1;
+            } else {
+                break;
+            }
+        }
+        self.d2[at] = d;
+        self.ids[at] = id;
+        if self.n == self.k {
+            self.worst = self.d2[self.k - 1];
+            self.worst_id = self.ids[self.k - 1];
+        }
+    }
+}
+
+impl Visitor for KBest<'_> {
+    #[inline]
+    fn visit(&mut self, xs: &[f64], ys: &[f64], ids: &[u32]) {
+        for ((&x, &y), &id) in xs.iter().zip(ys).zip(ids) {
+            let (dx, dy) = (self.px - x, self.py - y);
+            let d = dx * dx + dy * dy;
+            if d <= self.worst && (d < self.worst || id < self.worst_id) {
+                self.insert(d, id);
+            }
+        }
+    }
+
+    #[inline]
+    fn worst_d2(&self) -> f64 {
+        self.worst
+    }
+}
+
+impl NeighbourIndex for PointIndex {
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    fn nearest(&self, p: Point2) -> Option<Neighbour> {
+        let mut nearest = Nearest {
+            px: p.x,
+            py: p.y,
+            d2: f64::INFINITY,
+            id: NO_POINT,
+        };
+        self.search(p, &mut nearest);
+        (nearest.id != NO_POINT).then(|| (nearest.id as usize, nearest.d2.sqrt()))
+    }
+
+    fn k_nearest(&self, p: Point2, k: usize, out: &mut Vec<Neighbour>) {
+        out.clear();
+        with_scratch(k.min(self.xs.len()), |d2, ids| {
+            let n = self.k_nearest_into(p, d2, ids);
+            out.extend(
+                ids[..n]
+                    .iter()
+                    .zip(&d2[..n])
+                    .map(|(&i, &d)| (i as usize, d.sqrt())),
+            );
+        });
+    }
+}
+
+/// Bounding box of the finite points and their number.
+fn bounding_box<'a>(points: impl Iterator<Item = &'a Point2>) -> (Point2, Point2, usize) {
+    let mut lo = Point2::new(f64::INFINITY, f64::INFINITY);
+    let mut hi = Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
+    let mut n = 0;
+    for p in points.filter(|p| p.is_finite()) {
+        lo.x = lo.x.min(p.x);
+        lo.y = lo.y.min(p.y);
+        hi.x = hi.x.max(p.x);
+        hi.y = hi.y.max(p.y);
+        n += 1;
+    }
+    (lo, hi, n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn degenerate_sets_are_handled() {
+        let same = vec![Point2::new(3.0, 3.0); 5];
+        let index = PointIndex::new(&same);
+        assert_eq!(index.nearest(Point2::new(0.0, 0.0)).map(|n| n.0), Some(0));
+        let line: Vec<_> = (0..100).map(|i| Point2::new(i as f64, 7.0)).collect();
+        let index = PointIndex::new(&line);
+        assert_eq!(
+            index.nearest(Point2::new(41.4, -1e3)).map(|n| n.0),
+            Some(41)
+        );
+        let huge = [Point2::new(-1e308, 0.0), Point2::new(1e308, 1.0)];
+        let index = PointIndex::new(&huge);
+        assert!(index.nearest(Point2::new(1e307, 0.0)).is_some());
+        let index = PointIndex::new(&[Point2::new(f64::NAN, 0.0)]);
+        assert_eq!(index.len(), 1);
+        assert_eq!(index.nearest(Point2::new(0.0, 0.0)), None);
+    }
+
+    #[test]
+    fn far_queries_terminate() {
+        let pts: Vec<_> = (0..50)
+            .map(|i| Point2::new((i % 7) as f64, (i / 7) as f64))
+            .collect();
+        let index = PointIndex::new(&pts);
+        assert_eq!(index.nearest(Point2::new(1e6, -1e6)).map(|n| n.0), Some(6));
+        assert_eq!(index.nearest(Point2::new(f64::INFINITY, 0.0)), None);
+    }
+}

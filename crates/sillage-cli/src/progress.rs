@@ -1,0 +1,42 @@
+//! Progress bars on stderr; hidden when stderr is not a terminal, so logs stay clean.
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use sillage::FrameReport;
+
+/// A per-frame progress bar showing detections and speed.
+pub struct FrameProgress {
+    bar: ProgressBar,
+}
+
+impl FrameProgress {
+    /// A bar for `total` frames (a spinner when the length is unknown, e.g. a video).
+    pub fn new(total: Option<usize>, what: &str) -> Self {
+        let bar = match total {
+            Some(n) => ProgressBar::with_draw_target(Some(n as u64), ProgressDrawTarget::stderr()),
+            None => ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr()),
+        };
+        let template =
+            format!("{what} {{bar:30}} {{pos}}/{{len}} frames {{per_sec}} · {{msg}} · eta {{eta}}");
+        if let Ok(style) = ProgressStyle::with_template(&template) {
+            bar.set_style(style);
+        }
+        Self { bar }
+    }
+
+    /// Advances by one frame.
+    pub fn frame(&mut self, report: &FrameReport) {
+        self.bar
+            .set_message(format!("{} detections", report.detections));
+        self.bar.inc(1);
+    }
+
+    /// Advances by one item that has no report (rendering, writing).
+    pub fn tick(&mut self) {
+        self.bar.inc(1);
+    }
+
+    /// Clears the bar.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}

@@ -1,0 +1,41 @@
+//! Blob detection on a 2048² frame with ~25,000 Gaussian spots (σ = 1.2 px) and noise, seeded.
+//! Run with `cargo bench -p sillage-detect --bench blob`.
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::hint::black_box;
+
+use common::{Rng, Spot, render};
+use criterion::{Criterion, criterion_group, criterion_main};
+use sillage_core::Detector;
+use sillage_detect::{BlobDetector, BlobFilter, BlobParams};
+
+fn bench_blob(c: &mut Criterion) {
+    let side = 2048;
+    let mut rng = Rng(2024);
+    let spots: Vec<Spot> = (0..25_000)
+        .map(|_| Spot {
+            x: rng.uniform() * side as f64,
+            y: rng.uniform() * side as f64,
+            amplitude: 0.3 + 0.5 * rng.uniform(),
+        })
+        .collect();
+    let frame = render(side, side, 0.1, &spots, 1.2, 0.02, &mut rng);
+    let mut group = c.benchmark_group("blob_2048x2048_25k");
+    for filter in [BlobFilter::Dog, BlobFilter::Log] {
+        let mut detector = BlobDetector::new(BlobParams {
+            filter,
+            ..BlobParams::default()
+        })
+        .unwrap();
+        let mut out = Vec::new();
+        group.bench_function(format!("{filter:?}"), |b| {
+            b.iter(|| detector.detect(black_box(&frame), &mut out).unwrap())
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_blob);
+criterion_main!(benches);

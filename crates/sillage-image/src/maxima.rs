@@ -1,0 +1,154 @@
+//! Local maxima above a threshold in a `(2n+1)²` window (TracTrac's `maximaThresh`, with a
+//! deterministic tie-break instead of its unseeded random one).
+
+use rayon::prelude::*;
+use sillage_core::GrayImage;
+
+/// Rows per parallel job; fixed, so the output never depends on the thread count.
+const BAND_ROWS: usize = 32;
+
+/// Integer position of a local maximum, px.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Peak {
+    /// Row.
+    pub y: usize,
+    /// Column.
+    pub x: usize,
+}
+
+/// Finds local maxima; keeps per-band buffers so that repeated calls allocate nothing once
+/// the buffers have grown.
+#[derive(Debug, Clone, Default)]
+pub struct PeakFinder {
+    bands: Vec<Vec<Peak>>,
+}
+
+impl PeakFinder {
+    /// An empty finder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Writes into `out` (cleared first), in raster order, every pixel `p` with
+    /// `image[p] > threshold` that is the maximum of its `(2·half_window+1)²` window, ties
+    /// going to the first pixel in raster order: `p` must be strictly greater than the window
+    /// pixels before it (in raster order) and not smaller than those after it. A plateau that
+    /// fits in one window thus gives exactly one peak, its first pixel. Pixels closer than
+    /// `half_window` to the border are skipped (as TracTrac does). NaN is never a peak, and a
+    /// NaN in a window rules out a peak there.
+    ///
+    /// Fast method, candidates first: only a pixel above the threshold that beats its left
+    /// neighbour and is not beaten by its right one can be a peak. A branch-free compare over
+    /// 32 pixels at a time (vectorised) gives a bit mask of those candidates,
+    /// and only they get the full window check, so the cost is one read of the image plus
+    /// work proportional to the number of candidates, with no intermediate image.
+    pub fn find(
+        &mut self,
+        image: &GrayImage,
+        half_window: usize,
+        threshold: f32,
+        out: &mut Vec<Peak>,
+    ) {
+        out.clear();
+        let (width, height) = image.dimensions();
+        let n = half_window;
+        if width <= 2 * n || height <= 2 * n {
+            return;
+        }
+        let bands = (height - 2 * n).div_ceil(BAND_ROWS);
+        if self.bands.len() < bands {
+            self.bands.resize_with(bands, Vec::new);
+        }
+        self.bands[..bands]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(band, peaks)| {
+                let y0 = n + band * BAND_ROWS;
+                let y1 = (y0 + BAND_ROWS).min(height - n);
+                scan_band(image, y0..y1, n, threshold, peaks);
+            });
+        for band in &self.bands[..bands] {
+            out.extend_from_slice(band);
+        }
+    }
+}
+
+/// Pixels compared at once when looking for candidates (one bit each in a `u32` mask).
+const CANDIDATE_LANES: usize = 32;
+
+/// Finds the peaks of rows `ys` into `peaks` (cleared first; see [`PeakFinder::find`]).
+fn scan_band(
+    image: &GrayImage,
+    ys: std::ops::Range<usize>,
+    n: usize,
+    threshold: f32,
+    peaks: &mut Vec<Peak>,
+) {
+    let width = image.width();
+    peaks.clear();
+    let (start, end) = (n, width - n);
+    for y in ys {
+        let row = image.row(y);
+        let mut x = start;
+        while x < end {
+            let lanes = CANDIDATE_LANES.min(end - x);
+            let mut mask = if lanes == CANDIDATE_LANES {
+                candidate_mask(row, x, threshold)
+            } else {
+                (0..lanes).fold(0u32, |m, i| {
+                    m | (u32::from(is_candidate(row, x + i, threshold)) << i)
+                })
+            };
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if is_first_window_max(image, x + i, y, n, row[x + i]) {
+                    peaks.push(Peak { y, x: x + i });
+                }
+            }
+            x += lanes;
+        }
+    }
+}
+
+/// `row[x] > threshold`, `row[x] > row[x − 1]` and `row[x] >= row[x + 1]` (false for NaN).
+#[inline(always)]
+fn is_candidate(row: &[f32], x: usize, threshold: f32) -> bool {
+    let v = row[x];
+    (v > threshold) & (v > row[x - 1]) & (v >= row[x + 1])
+}
+
+/// Bit `i` set when `x + i` is a candidate, for `CANDIDATE_LANES` pixels from `x`: fixed-size
+/// branch-free compares the compiler turns into SIMD compares and a mask extraction.
+#[inline(always)]
+fn candidate_mask(row: &[f32], x: usize, threshold: f32) -> u32 {
+    let centre: &[f32; CANDIDATE_LANES] = row[x..x + CANDIDATE_LANES].try_into().unwrap();
+    let left: &[f32; CANDIDATE_LANES] = row[x - 1..x - 1 + CANDIDATE_LANES].try_into().unwrap();
+    let right: &[f32; CANDIDATE_LANES] = row[x + 1..x + 1 + CANDIDATE_LANES].try_into().unwrap();
+    let mut mask = 0u32;
+    for i in 0..CANDIDATE_LANES {
+        let v = centre[i];
+        let hit = (v > threshold) & (v > left[i]) & (v >= right[i]);
+        mask |= u32::from(hit) << i;
+    }
+    mask
+}
+
+/// True when every pixel before `(x, y)` in its window is `< v` and every pixel after it is
+/// `<= v` (so a NaN in the window rules the peak out).
+fn is_first_window_max(image: &GrayImage, x: usize, y: usize, n: usize, v: f32) -> bool {
+    for yy in y - n..=y + n {
+        let r = &image.row(yy)[x - n..=x + n];
+        let ok = match yy.cmp(&y) {
+            std::cmp::Ordering::Less => r.iter().all(|&q| q < v),
+            std::cmp::Ordering::Greater => r.iter().all(|&q| q <= v),
+            std::cmp::Ordering::Equal => {
+                r[..n].iter().all(|&q| q < v) && r[n + 1..].iter().all(|&q| q <= v)
+            }
+        };
+        if !ok {
+            return false;
+        }
+    }
+    true
+}

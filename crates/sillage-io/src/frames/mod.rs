@@ -1,0 +1,294 @@
+//! Frame sources: image folders, glob patterns, single images, multi-page TIFF stacks and
+//! videos (through the `ffmpeg` program), decoded on a background thread with a bounded
+//! read-ahead queue so memory stays bounded whatever the length of the sequence.
+
+mod decode;
+mod encode;
+mod input;
+mod tiff_stack;
+mod video;
+
+use std::path::{Path, PathBuf};
+use std::thread::JoinHandle;
+
+use crossbeam_channel::{Receiver, Sender};
+use sillage_core::{Error, FrameIndex, GrayImage, Result};
+
+pub use decode::read_image;
+pub use encode::write_png16;
+
+use input::InputKind;
+use video::{FfmpegDecoder, VideoInfo};
+
+/// How frames are read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FrameOptions {
+    /// Frames decoded ahead of the consumer (the bounded queue's capacity); default 4.
+    pub read_ahead: usize,
+    /// Stop after this many frames (`None`: read them all).
+    pub max_frames: Option<usize>,
+    /// The `ffmpeg` program used for videos (a name looked up on `PATH`, or a path).
+    pub ffmpeg: PathBuf,
+    /// The `ffprobe` program used to read a video's size.
+    pub ffprobe: PathBuf,
+}
+
+impl Default for FrameOptions {
+    fn default() -> Self {
+        Self {
+            read_ahead: 4,
+            max_frames: None,
+            ffmpeg: "ffmpeg".into(),
+            ffprobe: "ffprobe".into(),
+        }
+    }
+}
+
+/// One decoded frame.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    /// 0-based index in the sequence.
+    pub index: FrameIndex,
+    /// The file it was read from (the stack or video file for pages and video frames).
+    pub path: PathBuf,
+    /// Grey levels in `[0, 1]`.
+    pub image: GrayImage,
+}
+
+/// A sequence of frames, decoded ahead on a background thread.
+///
+/// Iterate it to get `Result<Frame>` in order; after the first error it ends. Dropping it
+/// early stops the reading thread (and `ffmpeg`, for a video).
+#[derive(Debug)]
+pub struct FrameSource {
+    receiver: Option<Receiver<Result<Frame>>>,
+    worker: Option<JoinHandle<()>>,
+    len: Option<usize>,
+    dimensions: (usize, usize),
+    paths: Vec<PathBuf>,
+    ended: bool,
+}
+
+/// Opens `input`: a folder (its .tif/.tiff/.png/.jpg/.jpeg files in natural name order), a
+/// glob pattern (`"dir/*.tif"`), a single image, a multi-page TIFF (one frame per page) or a
+/// video (.avi/.mp4/.mov/.mkv, read through `ffmpeg`).
+///
+/// Pixels become grey levels in `[0, 1]`: 8-bit values / 255, 16-bit / 65535, 32-bit float
+/// grey TIFF kept as is; colour is converted with the Rec. 601 luma weights
+/// `0.299 R + 0.587 G + 0.114 B` (as OpenCV's, so frames match TracTrac's) and alpha is
+/// dropped. In a folder or glob every file is one frame (a TIFF's first page).
+///
+/// The first frame's size is read here, so a missing or unreadable input fails now rather
+/// than on the first iteration.
+pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
+    let limit = |n: usize| options.max_frames.map_or(n, |m| m.min(n));
+    let (sender, receiver) = crossbeam_channel::bounded(options.read_ahead);
+    let (len, dimensions, paths, worker) = match input::resolve(input)? {
+        InputKind::Files(mut files) => {
+            let first = &files[0];
+            let dimensions = decode::file_dimensions(first)
+                .map_err(|message| Error::frame(first, 0, decode_failure(&message)))?;
+            let len = limit(files.len());
+            files.truncate(len);
+            let worker_files = files.clone();
+            let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
+                read_files(&worker_files, emitter);
+            })?;
+            (Some(len), dimensions, files, worker)
+        }
+        InputKind::TiffStack { path, pages } => {
+            let dimensions = decode::file_dimensions(&path)
+                .map_err(|message| Error::frame(&path, 0, decode_failure(&message)))?;
+            let stack = path.clone();
+            let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
+                tiff_stack::read_pages(&stack, |page| match page {
+                    Ok(image) => emitter.frame(&stack, image),
+                    Err(message) => emitter.fail(&stack, decode_failure(&message)),
+                });
+            })?;
+            (Some(limit(pages)), dimensions, vec![path], worker)
+        }
+        InputKind::Video(path) => {
+            let info = video::probe(&options.ffprobe, &path)?;
+            let decoder = FfmpegDecoder::spawn(&options.ffmpeg, &path)?;
+            let video = path.clone();
+            let dimensions = (info.width, info.height);
+            let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
+                read_video(decoder, info, &video, emitter);
+            })?;
+            (info.frames.map(limit), dimensions, vec![path], worker)
+        }
+    };
+    Ok(FrameSource {
+        receiver: Some(receiver),
+        worker: Some(worker),
+        len,
+        dimensions,
+        paths,
+        ended: false,
+    })
+}
+
+fn decode_failure(message: &str) -> String {
+    format!("cannot decode: {message}; remove or replace the file")
+}
+
+fn read_files(files: &[PathBuf], emitter: &mut Emitter) {
+    for path in files {
+        let keep_going = match decode::decode_file(path) {
+            Ok(image) => emitter.frame(path, image),
+            Err(message) => emitter.fail(path, decode_failure(&message)),
+        };
+        if !keep_going {
+            return;
+        }
+    }
+}
+
+fn read_video(decoder: FfmpegDecoder, info: VideoInfo, path: &Path, emitter: &mut Emitter) {
+    decoder.read_frames(info, |frame| match frame {
+        Ok(image) => emitter.frame(path, image),
+        Err(message) => emitter.fail(
+            path,
+            format!(
+                "cannot decode: {message}; check the video with `ffprobe`, or convert it to \
+                 an image sequence"
+            ),
+        ),
+    });
+}
+
+/// Starts the reading thread, which runs `read` with an [`Emitter`] on `sender`.
+fn spawn(
+    sender: Sender<Result<Frame>>,
+    dimensions: (usize, usize),
+    max_frames: Option<usize>,
+    read: impl FnOnce(&mut Emitter) + Send + 'static,
+) -> Result<JoinHandle<()>> {
+    std::thread::Builder::new()
+        .name("sillage-frames".into())
+        .spawn(move || {
+            let mut emitter = Emitter {
+                sender,
+                dimensions,
+                max_frames,
+                next_index: 0,
+            };
+            read(&mut emitter);
+        })
+        .map_err(|e| Error::input(format!("cannot start the frame-reading thread: {e}")))
+}
+
+/// The reading thread's end of the queue: numbers frames, checks their size, and tells the
+/// reader when to stop (consumer gone, frame limit reached, or an error sent).
+struct Emitter {
+    sender: Sender<Result<Frame>>,
+    dimensions: (usize, usize),
+    max_frames: Option<usize>,
+    next_index: FrameIndex,
+}
+
+impl Emitter {
+    /// Sends one decoded frame; `false` means stop reading.
+    fn frame(&mut self, path: &Path, image: GrayImage) -> bool {
+        let index = self.next_index;
+        if self.max_frames.is_some_and(|m| index >= m as FrameIndex) {
+            return false;
+        }
+        if image.dimensions() != self.dimensions {
+            let (w0, h0) = self.dimensions;
+            let (w, h) = image.dimensions();
+            return self.fail(
+                path,
+                format!(
+                    "frame is {w}×{h} pixels but the first frame is {w0}×{h0}; all frames of a \
+                     sequence must have the same size (crop or resize them, or split the sequence)"
+                ),
+            );
+        }
+        let frame = Frame {
+            index,
+            path: path.to_path_buf(),
+            image,
+        };
+        self.next_index += 1;
+        let below_limit = self
+            .max_frames
+            .is_none_or(|m| self.next_index < m as FrameIndex);
+        self.sender.send(Ok(frame)).is_ok() && below_limit
+    }
+
+    /// Sends the error of the current frame; always `false` (stop reading).
+    fn fail(&mut self, path: &Path, message: String) -> bool {
+        // If the consumer is gone nobody needs the error.
+        let _ = self
+            .sender
+            .send(Err(Error::frame(path, self.next_index, message)));
+        false
+    }
+}
+
+impl FrameSource {
+    /// Number of frames, when known in advance (image files, TIFF pages, and videos whose
+    /// container records it): for progress bars.
+    #[expect(
+        clippy::len_without_is_empty,
+        reason = "a length hint for progress bars; an opened source always has a first frame"
+    )]
+    pub fn len(&self) -> Option<usize> {
+        self.len
+    }
+
+    /// `(width, height)` of the first frame; every frame must have this size.
+    pub fn dimensions(&self) -> (usize, usize) {
+        self.dimensions
+    }
+
+    /// The files read, in order: every image of a folder or glob, or the one stack or video.
+    pub fn paths(&self) -> &[PathBuf] {
+        &self.paths
+    }
+}
+
+impl Iterator for FrameSource {
+    type Item = Result<Frame>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.ended {
+            return None;
+        }
+        let received = self.receiver.as_ref().map(Receiver::recv);
+        match received {
+            Some(Ok(Ok(frame))) => Some(Ok(frame)),
+            Some(Ok(Err(error))) => {
+                self.ended = true;
+                Some(Err(error))
+            }
+            Some(Err(_)) | None => {
+                self.ended = true;
+                self.stop();
+                None
+            }
+        }
+    }
+}
+
+impl FrameSource {
+    /// Closes the queue (which makes the reader's next send fail) and joins the thread; a
+    /// panic there is a bug and is passed on.
+    fn stop(&mut self) {
+        self.receiver = None;
+        if let Some(worker) = self.worker.take()
+            && let Err(panic) = worker.join()
+            && !std::thread::panicking()
+        {
+            std::panic::resume_unwind(panic);
+        }
+    }
+}
+
+impl Drop for FrameSource {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}

@@ -1,0 +1,121 @@
+//! Files written under a temporary name (`.NAME.partial`) in the destination folder and
+//! renamed on success, so a reader never sees a half-written file under the final name.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use sillage_core::{Error, Result};
+
+/// A file being written as `.NAME.partial` beside its final `path`.
+///
+/// Dropping it without [`PartialFile::commit`] leaves the partial file in place: after an
+/// interrupted run it holds every row written so far.
+#[derive(Debug)]
+pub(crate) struct PartialFile {
+    final_path: PathBuf,
+    partial_path: PathBuf,
+    writer: BufWriter<File>,
+}
+
+impl PartialFile {
+    /// Creates (or truncates) `.NAME.partial` in the folder of `path`.
+    pub(crate) fn create(path: &Path) -> Result<Self> {
+        let partial_path = partial_path(path)?;
+        let file = File::create(&partial_path).map_err(|e| Error::Io {
+            path: partial_path.clone(),
+            cause: e,
+            hint: "check that the output folder exists and is writable".into(),
+        })?;
+        Ok(Self {
+            final_path: path.to_path_buf(),
+            partial_path,
+            writer: BufWriter::new(file),
+        })
+    }
+
+    /// The temporary path being written.
+    pub(crate) fn partial_path(&self) -> &Path {
+        &self.partial_path
+    }
+
+    /// Writes `bytes` whole, naming the partial file on error.
+    pub(crate) fn write_all(&mut self, bytes: &[u8]) -> Result<()> {
+        self.writer
+            .write_all(bytes)
+            .map_err(|e| Error::io(&self.partial_path, e))
+    }
+
+    /// Flushes, closes and renames the partial file to its final name.
+    pub(crate) fn commit(self) -> Result<PathBuf> {
+        let Self {
+            final_path,
+            partial_path,
+            writer,
+        } = self;
+        // Flushed but not fsync'ed: the rename guards against interrupted runs, and an fsync
+        // per synthetic frame would dominate the cost of writing long sequences.
+        let file = writer
+            .into_inner()
+            .map_err(|e| Error::io(&partial_path, e.into_error()))?;
+        drop(file);
+        std::fs::rename(&partial_path, &final_path).map_err(|e| Error::io(&final_path, e))?;
+        Ok(final_path)
+    }
+
+    /// Gives up: removes the partial file (used when a one-shot write fails half way).
+    pub(crate) fn abandon(self) {
+        let Self {
+            partial_path,
+            writer,
+            ..
+        } = self;
+        drop(writer);
+        // Best effort: the original error is what the caller reports.
+        let _ = std::fs::remove_file(partial_path);
+    }
+}
+
+/// Lets encoders (PNG, Parquet) write straight into the partial file.
+impl Write for PartialFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.writer.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.writer.flush()
+    }
+}
+
+/// `.NAME.partial` in the folder of `path`.
+pub(crate) fn partial_path(path: &Path) -> Result<PathBuf> {
+    let name = path.file_name().ok_or_else(|| {
+        Error::input(format!(
+            "output path `{}` has no file name; give a file such as `out/tracks.csv`",
+            path.display()
+        ))
+    })?;
+    let mut partial = std::ffi::OsString::from(".");
+    partial.push(name);
+    partial.push(".partial");
+    Ok(path.with_file_name(partial))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn partial_file_is_renamed_on_commit_only() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.txt");
+        let mut file = PartialFile::create(&path).unwrap();
+        file.write_all(b"row\n").unwrap();
+        let partial = file.partial_path().to_path_buf();
+        assert_eq!(partial.file_name().unwrap(), ".out.txt.partial");
+        assert!(!path.exists());
+        assert_eq!(file.commit().unwrap(), path);
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "row\n");
+        assert!(!partial.exists());
+    }
+}

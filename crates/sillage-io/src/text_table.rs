@@ -1,0 +1,246 @@
+//! Shared plumbing of the text tables (TracTrac `_track.txt`, CSV tracks, truth and
+//! detections): a whole-row writer on a partial file, a header-checked CSV reader that names
+//! the file, line and column of every error, and number formatting.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use sillage_core::{Error, Result};
+
+use crate::WrittenSummary;
+use crate::partial::PartialFile;
+
+/// Writes rows to a `.NAME.partial` file, one whole batch at a time, and renames it on
+/// [`RowWriter::finish`]. An interrupted run leaves only complete rows behind.
+#[derive(Debug)]
+pub(crate) struct RowWriter {
+    file: PartialFile,
+    buffer: String,
+    rows: u64,
+}
+
+impl RowWriter {
+    /// Creates the partial file and writes `header` (whole lines, newline-terminated).
+    pub(crate) fn create(path: &Path, header: &str) -> Result<Self> {
+        let mut file = PartialFile::create(path)?;
+        file.write_all(header.as_bytes())?;
+        Ok(Self {
+            file,
+            buffer: String::new(),
+            rows: 0,
+        })
+    }
+
+    /// Formats every item of `items` as one row with `format_row` (which writes the row
+    /// without its newline) and writes the batch in one call.
+    pub(crate) fn write_rows<T>(
+        &mut self,
+        items: &[T],
+        mut format_row: impl FnMut(&mut String, &T) -> Result<()>,
+    ) -> Result<()> {
+        self.buffer.clear();
+        for item in items {
+            format_row(&mut self.buffer, item)?;
+            self.buffer.push('\n');
+        }
+        self.file.write_all(self.buffer.as_bytes())?;
+        self.rows += items.len() as u64;
+        Ok(())
+    }
+
+    /// Closes the file under its final name.
+    pub(crate) fn finish(self) -> Result<WrittenSummary> {
+        let rows = self.rows;
+        let path = self.file.commit()?;
+        Ok(WrittenSummary { rows, path })
+    }
+}
+
+/// Appends `value` in its shortest exact form (lossless round trip), or nothing for `None`.
+pub(crate) fn push_opt(out: &mut String, value: Option<f64>) {
+    if let Some(v) = value {
+        push_f64(out, v);
+    }
+}
+
+/// Appends `value` in its shortest exact form.
+pub(crate) fn push_f64(out: &mut String, value: f64) {
+    // Writing to a String cannot fail.
+    let _ = write!(out, "{value}");
+}
+
+/// A CSV file with a header row, read with every column looked up by name.
+///
+/// The file is held in memory so that errors can name the true line of a row (the `csv`
+/// crate's own line count skips blank lines).
+pub(crate) struct CsvTable {
+    path: PathBuf,
+    content: Vec<u8>,
+    /// For each wanted column, its index in the file (None: optional and absent).
+    indices: Vec<Option<usize>>,
+    names: Vec<&'static str>,
+}
+
+/// One data row of a [`CsvTable`].
+pub(crate) struct CsvRow<'a> {
+    table: &'a CsvTable,
+    record: &'a csv::StringRecord,
+}
+
+fn csv_reader(content: &[u8]) -> csv::Reader<&[u8]> {
+    csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(content)
+}
+
+impl CsvTable {
+    /// Opens `path` and finds the `required` and `optional` columns in its header.
+    /// `expected` describes the header for error messages.
+    pub(crate) fn open(
+        path: &Path,
+        required: &[&'static str],
+        optional: &[&'static str],
+        expected: &str,
+    ) -> Result<Self> {
+        let content = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let mut table = Self {
+            path: path.to_path_buf(),
+            content,
+            indices: Vec::new(),
+            names: required.iter().chain(optional).copied().collect(),
+        };
+        let mut reader = csv_reader(&table.content);
+        let header = reader.headers().map_err(|e| table.csv_error(&e))?.clone();
+        let find = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
+        for &name in required {
+            let index = find(name).ok_or_else(|| {
+                Error::format(
+                    path,
+                    Some(1),
+                    format!("missing column `{name}`; the header must be `{expected}`"),
+                )
+            })?;
+            table.indices.push(Some(index));
+        }
+        table.indices.extend(optional.iter().map(|name| find(name)));
+        Ok(table)
+    }
+
+    /// Calls `each` on every data row, in order.
+    pub(crate) fn for_each_row(
+        &self,
+        mut each: impl FnMut(&CsvRow<'_>) -> Result<()>,
+    ) -> Result<()> {
+        let mut reader = csv_reader(&self.content);
+        let mut record = csv::StringRecord::new();
+        loop {
+            match reader.read_record(&mut record) {
+                Ok(false) => return Ok(()),
+                Ok(true) => each(&CsvRow {
+                    table: self,
+                    record: &record,
+                })?,
+                Err(e) => return Err(self.csv_error(&e)),
+            }
+        }
+    }
+
+    /// The 1-based line of the record the reader started at `byte` (its position includes
+    /// the blank and comment lines skipped before the record).
+    fn line_at(&self, byte: u64) -> usize {
+        let content = &self.content;
+        let mut at = usize::try_from(byte).map_or(content.len(), |b| b.min(content.len()));
+        while let Some(&b) = content.get(at) {
+            match b {
+                b'\n' | b'\r' => at += 1,
+                b'#' => {
+                    at += content[at..]
+                        .iter()
+                        .position(|&b| b == b'\n')
+                        .map_or(content.len() - at, |p| p + 1);
+                }
+                _ => break,
+            }
+        }
+        content[..at].iter().filter(|&&b| b == b'\n').count() + 1
+    }
+
+    fn csv_error(&self, error: &csv::Error) -> Error {
+        let line = error.position().map(|p| self.line_at(p.byte()));
+        let message = match error.kind() {
+            csv::ErrorKind::UnequalLengths {
+                expected_len, len, ..
+            } => format!(
+                "this row has {len} fields but the header has {expected_len}; fix the row so \
+                 every row has one value per column"
+            ),
+            csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text; save the file as UTF-8".into(),
+            _ => format!("cannot read CSV: {error}"),
+        };
+        Error::format(&self.path, line, message)
+    }
+}
+
+impl CsvRow<'_> {
+    /// An error at this row's line.
+    pub(crate) fn error(&self, message: impl Into<String>) -> Error {
+        let line = self.record.position().map(|p| self.table.line_at(p.byte()));
+        Error::format(&self.table.path, line, message)
+    }
+
+    fn text(&self, column: usize) -> Option<&str> {
+        self.table.indices[column]
+            .and_then(|i| self.record.get(i))
+            .filter(|t| !t.is_empty())
+    }
+
+    /// Wanted column `column` as a non-negative integer (also accepts `3.0`).
+    pub(crate) fn index(&self, column: usize) -> Result<u64> {
+        let name = self.table.names[column];
+        let text = self.text(column).ok_or_else(|| {
+            self.error(format!("`{name}` is empty; fill it in or remove the row"))
+        })?;
+        parse_index(text).ok_or_else(|| {
+            self.error(format!(
+                "`{name}` = `{text}` is not a non-negative integer; fix or remove the row"
+            ))
+        })
+    }
+
+    /// Wanted column `column` as a finite number (positions: NaN or empty is an error).
+    pub(crate) fn finite(&self, column: usize) -> Result<f64> {
+        let name = self.table.names[column];
+        match self.optional(column)? {
+            Some(v) if v.is_finite() => Ok(v),
+            Some(v) => Err(self.error(format!(
+                "`{name}` is {v}; positions must be finite numbers, fix or remove the row"
+            ))),
+            None => Err(self.error(format!(
+                "`{name}` is empty; positions are required, fill it in or remove the row"
+            ))),
+        }
+    }
+
+    /// Wanted column `column` as a number; empty, absent or NaN gives `None`.
+    pub(crate) fn optional(&self, column: usize) -> Result<Option<f64>> {
+        let Some(text) = self.text(column) else {
+            return Ok(None);
+        };
+        let name = self.table.names[column];
+        let value: f64 = text.parse().map_err(|_| {
+            self.error(format!(
+                "`{name}` = `{text}` is not a number; fix or remove the row"
+            ))
+        })?;
+        Ok(Some(value))
+    }
+}
+
+/// Parses a frame or track index: an integer, or a float with no fractional part.
+pub(crate) fn parse_index(text: &str) -> Option<u64> {
+    text.parse::<u64>().ok().or_else(|| {
+        let v: f64 = text.parse().ok()?;
+        (v >= 0.0 && v.fract() == 0.0 && v < u64::MAX as f64).then_some(v as u64)
+    })
+}

@@ -1,0 +1,225 @@
+//! Parquet track tables: the CSV's column names, `frame`/`particle` as Int64, the other
+//! columns Float64 (nullable for the kinematics), zstd-compressed, one row group per
+//! [`ROW_GROUP_ROWS`] rows so memory stays bounded. Readable by pandas/pyarrow directly.
+
+use std::fs::File;
+use std::path::Path;
+use std::sync::Arc;
+
+use arrow::array::{Array, ArrayRef, AsArray, Float64Array, Int64Array, RecordBatch};
+use arrow::datatypes::{DataType, Field, Float64Type, Int64Type, Schema, SchemaRef};
+use parquet::arrow::ArrowWriter;
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use parquet::basic::{Compression, ZstdLevel};
+use parquet::file::metadata::KeyValue;
+use parquet::file::properties::WriterProperties;
+use sillage_core::{Error, Result, TrackPoint, TrackSink};
+
+use super::column_buffer::TrackColumns;
+use super::columns::TRACK_COLUMNS;
+use super::{TrackFileHeader, TrackWriter, WrittenSummary};
+use crate::partial::PartialFile;
+
+/// Rows buffered before a row group is written.
+const ROW_GROUP_ROWS: usize = 65_536;
+
+fn schema() -> SchemaRef {
+    let fields: Vec<Field> = TRACK_COLUMNS
+        .iter()
+        .enumerate()
+        .map(|(i, name)| match i {
+            0 | 1 => Field::new(*name, DataType::Int64, false),
+            2 | 3 => Field::new(*name, DataType::Float64, false),
+            _ => Field::new(*name, DataType::Float64, true),
+        })
+        .collect();
+    Arc::new(Schema::new(fields))
+}
+
+fn parquet_error(path: &Path, action: &str, error: impl std::fmt::Display) -> Error {
+    Error::format(path, None, format!("cannot {action} Parquet: {error}"))
+}
+
+/// Streams track points into a Parquet file.
+pub(crate) struct ParquetTrackWriter {
+    writer: ArrowWriter<PartialFile>,
+    schema: SchemaRef,
+    buffer: TrackColumns,
+    rows: u64,
+    partial: std::path::PathBuf,
+}
+
+impl std::fmt::Debug for ParquetTrackWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ParquetTrackWriter")
+            .field("partial", &self.partial)
+            .field("rows", &self.rows)
+            .finish_non_exhaustive()
+    }
+}
+
+impl ParquetTrackWriter {
+    /// Creates `.NAME.partial` beside `path`; `header` goes into the key-value metadata
+    /// (`program_version`, `param:KEY`).
+    pub(crate) fn create(path: &Path, header: &TrackFileHeader) -> Result<Self> {
+        let file = PartialFile::create(path)?;
+        let partial = file.partial_path().to_path_buf();
+        let mut metadata = vec![KeyValue::new(
+            "program_version".into(),
+            header.program_version.clone(),
+        )];
+        metadata.extend(
+            header
+                .parameters
+                .iter()
+                .map(|(k, v)| KeyValue::new(format!("param:{k}"), v.clone())),
+        );
+        let properties = WriterProperties::builder()
+            .set_compression(Compression::ZSTD(ZstdLevel::default()))
+            .set_max_row_group_row_count(Some(ROW_GROUP_ROWS))
+            .set_key_value_metadata(Some(metadata))
+            .build();
+        let schema = schema();
+        let writer = ArrowWriter::try_new(file, schema.clone(), Some(properties))
+            .map_err(|e| parquet_error(&partial, "start", e))?;
+        Ok(Self {
+            writer,
+            schema,
+            buffer: TrackColumns::default(),
+            rows: 0,
+            partial,
+        })
+    }
+
+    fn flush_buffer(&mut self) -> Result<()> {
+        if self.buffer.len() == 0 {
+            return Ok(());
+        }
+        let b = &self.buffer;
+        let mut arrays: Vec<ArrayRef> = vec![
+            Arc::new(Int64Array::from(b.frame.clone())),
+            Arc::new(Int64Array::from(b.particle.clone())),
+            Arc::new(Float64Array::from(b.x.clone())),
+            Arc::new(Float64Array::from(b.y.clone())),
+        ];
+        arrays.extend(
+            b.kinematics
+                .iter()
+                .map(|c| Arc::new(Float64Array::from(c.clone())) as ArrayRef),
+        );
+        let batch = RecordBatch::try_new(self.schema.clone(), arrays)
+            .map_err(|e| parquet_error(&self.partial, "assemble", e))?;
+        self.writer
+            .write(&batch)
+            .map_err(|e| parquet_error(&self.partial, "write", e))?;
+        self.rows += self.buffer.len() as u64;
+        self.buffer.clear();
+        Ok(())
+    }
+}
+
+impl TrackSink for ParquetTrackWriter {
+    fn accept(&mut self, points: &[TrackPoint]) -> Result<()> {
+        for point in points {
+            self.buffer.push(point)?;
+            if self.buffer.len() >= ROW_GROUP_ROWS {
+                self.flush_buffer()?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl TrackWriter for ParquetTrackWriter {
+    fn finish(mut self: Box<Self>) -> Result<WrittenSummary> {
+        self.flush_buffer()?;
+        let Self {
+            writer,
+            rows,
+            partial,
+            ..
+        } = *self;
+        let file = writer
+            .into_inner()
+            .map_err(|e| parquet_error(&partial, "finish", e))?;
+        let path = file.commit()?;
+        Ok(WrittenSummary { rows, path })
+    }
+}
+
+/// Reads a Parquet track table. `frame`, `particle`, `x`, `y` are required; integer and
+/// float columns of other widths are converted.
+pub(crate) fn read_parquet(path: &Path) -> Result<Vec<TrackPoint>> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let reader = ParquetRecordBatchReaderBuilder::try_new(file)
+        .and_then(|b| b.build())
+        .map_err(|e| parquet_error(path, "read", e))?;
+    let mut points = Vec::new();
+    let mut columns = TrackColumns::default();
+    for batch in reader {
+        let batch = batch.map_err(|e| parquet_error(path, "read", e))?;
+        columns.clear();
+        let column = |name: &str, ty: &DataType| -> Result<Option<ArrayRef>> {
+            batch
+                .column_by_name(name)
+                .map(|c| arrow::compute::cast(c, ty))
+                .transpose()
+                .map_err(|e| {
+                    Error::format(
+                        path,
+                        None,
+                        format!("column `{name}` cannot be read as {ty}: {e}"),
+                    )
+                })
+        };
+        let required = |name: &str, ty: &DataType| -> Result<ArrayRef> {
+            column(name, ty)?.ok_or_else(|| {
+                Error::format(
+                    path,
+                    None,
+                    format!(
+                        "missing column `{name}`; expected columns {}",
+                        TRACK_COLUMNS.join(",")
+                    ),
+                )
+            })
+        };
+        let ints = |name: &str| -> Result<Vec<i64>> {
+            let array = required(name, &DataType::Int64)?;
+            no_nulls(path, name, &array)?;
+            Ok(array.as_primitive::<Int64Type>().values().to_vec())
+        };
+        let floats = |name: &str| -> Result<Vec<f64>> {
+            let array = required(name, &DataType::Float64)?;
+            no_nulls(path, name, &array)?;
+            Ok(array.as_primitive::<Float64Type>().values().to_vec())
+        };
+        columns.frame = ints(TRACK_COLUMNS[0])?;
+        columns.particle = ints(TRACK_COLUMNS[1])?;
+        columns.x = floats(TRACK_COLUMNS[2])?;
+        columns.y = floats(TRACK_COLUMNS[3])?;
+        for (slot, name) in columns.kinematics.iter_mut().zip(&TRACK_COLUMNS[4..]) {
+            *slot = match column(name, &DataType::Float64)? {
+                Some(array) => array.as_primitive::<Float64Type>().iter().collect(),
+                None => vec![None; batch.num_rows()],
+            };
+        }
+        points.extend(columns.to_points(path, points.len() + 1)?);
+    }
+    Ok(points)
+}
+
+fn no_nulls(path: &Path, name: &str, array: &ArrayRef) -> Result<()> {
+    if array.null_count() == 0 {
+        Ok(())
+    } else {
+        Err(Error::format(
+            path,
+            None,
+            format!(
+                "column `{name}` has {} missing values; it is required in every row",
+                array.null_count()
+            ),
+        ))
+    }
+}

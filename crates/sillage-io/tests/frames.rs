@@ -1,0 +1,280 @@
+//! Frame sources: folders, globs, stacks, conversions, and every error case.
+
+use std::path::Path;
+use std::time::Duration;
+
+use sillage_core::{Error, GrayImage};
+use sillage_io::{FrameOptions, open_frames, read_image, write_png16};
+
+fn gray8(path: &Path, width: u32, height: u32, value: u8) {
+    image::GrayImage::from_pixel(width, height, image::Luma([value]))
+        .save(path)
+        .unwrap();
+}
+
+fn tiff16_pages(path: &Path, width: u32, height: u32, values: &[u16]) {
+    let file = std::fs::File::create(path).unwrap();
+    let mut encoder = tiff::encoder::TiffEncoder::new(file).unwrap();
+    for &v in values {
+        let data = vec![v; (width * height) as usize];
+        encoder
+            .write_image::<tiff::encoder::colortype::Gray16>(width, height, &data)
+            .unwrap();
+    }
+}
+
+fn open(input: &Path) -> sillage_core::Result<sillage_io::FrameSource> {
+    open_frames(input.to_str().unwrap(), &FrameOptions::default())
+}
+
+#[test]
+fn folder_of_8bit_png_in_natural_order() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, value) in [("f10.png", 30u8), ("f2.png", 20), ("f1.png", 10)] {
+        gray8(&dir.path().join(name), 5, 3, value);
+    }
+    std::fs::write(dir.path().join("notes.txt"), "not a frame").unwrap();
+    let source = open(dir.path()).unwrap();
+    assert_eq!(source.len(), Some(3));
+    assert_eq!(source.dimensions(), (5, 3));
+    let names: Vec<_> = source
+        .paths()
+        .iter()
+        .map(|p| p.file_name().unwrap().to_str().unwrap().to_owned())
+        .collect();
+    assert_eq!(names, ["f1.png", "f2.png", "f10.png"]);
+    let frames: Vec<_> = source.map(Result::unwrap).collect();
+    let values: Vec<f32> = frames.iter().map(|f| f.image.get(4, 2)).collect();
+    assert_eq!(values, [10.0 / 255.0, 20.0 / 255.0, 30.0 / 255.0]);
+    assert_eq!(
+        frames.iter().map(|f| f.index).collect::<Vec<_>>(),
+        [0, 1, 2]
+    );
+}
+
+#[test]
+fn png16_round_trip_and_clamping() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("a.png");
+    let image = GrayImage::from_vec(4, 1, vec![0.0, 0.25, 1.5, -1.0]).unwrap();
+    write_png16(&path, &image).unwrap();
+    assert!(!dir.path().join(".a.png.partial").exists());
+    let back = read_image(&path).unwrap();
+    let expected = [0.0, 0.25, 1.0, 0.0];
+    for (got, want) in back.as_slice().iter().zip(expected) {
+        assert!((got - want).abs() <= 0.5 / 65535.0, "{got} vs {want}");
+    }
+    let raw = image::open(&path).unwrap();
+    assert_eq!(raw.color(), image::ColorType::L16);
+}
+
+#[test]
+fn rgb_png_becomes_rec601_grey_and_alpha_is_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 0]))
+        .save(dir.path().join("1.png"))
+        .unwrap();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([0, 0, 255, 7]))
+        .save(dir.path().join("2.png"))
+        .unwrap();
+    let frames: Vec<_> = open(dir.path()).unwrap().map(Result::unwrap).collect();
+    assert!((frames[0].image.get(0, 0) - 0.299).abs() < 1e-6);
+    assert!((frames[1].image.get(1, 1) - 0.114).abs() < 1e-6);
+}
+
+#[test]
+fn jpeg_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("frame.jpg");
+    gray8(&path, 16, 8, 128);
+    let frames: Vec<_> = open(&path).unwrap().map(Result::unwrap).collect();
+    assert_eq!(frames.len(), 1);
+    assert_eq!(frames[0].image.dimensions(), (16, 8));
+    assert!((frames[0].image.get(7, 3) - 128.0 / 255.0).abs() < 2.0 / 255.0);
+}
+
+#[test]
+fn three_page_tiff_stack_gives_three_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stack.tif");
+    tiff16_pages(&path, 6, 4, &[0, 32768, 65535]);
+    let source = open(&path).unwrap();
+    assert_eq!(source.len(), Some(3));
+    assert_eq!(source.dimensions(), (6, 4));
+    let frames: Vec<_> = source.map(Result::unwrap).collect();
+    let values: Vec<f32> = frames.iter().map(|f| f.image.get(5, 3)).collect();
+    assert_eq!(values, [0.0, 32768.0 / 65535.0, 1.0]);
+    assert!(frames.iter().all(|f| f.path == path));
+}
+
+#[test]
+fn float_tiff_is_kept_as_is_and_max_frames_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("float.tiff");
+    let file = std::fs::File::create(&path).unwrap();
+    let mut encoder = tiff::encoder::TiffEncoder::new(file).unwrap();
+    for v in [2.5f32, -1.0, 0.5] {
+        encoder
+            .write_image::<tiff::encoder::colortype::Gray32Float>(3, 2, &[v; 6])
+            .unwrap();
+    }
+    drop(encoder);
+    let options = FrameOptions {
+        max_frames: Some(2),
+        ..FrameOptions::default()
+    };
+    let source = open_frames(path.to_str().unwrap(), &options).unwrap();
+    assert_eq!(source.len(), Some(2));
+    let values: Vec<f32> = source.map(|f| f.unwrap().image.get(0, 0)).collect();
+    assert_eq!(values, [2.5, -1.0]);
+}
+
+#[test]
+fn unsupported_pixel_type_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("u32.tif");
+    let file = std::fs::File::create(&path).unwrap();
+    tiff::encoder::TiffEncoder::new(file)
+        .unwrap()
+        .write_image::<tiff::encoder::colortype::Gray32>(2, 2, &[1u32; 4])
+        .unwrap();
+    let mut source = open(&path).unwrap();
+    let err = source.next().unwrap().unwrap_err().to_string();
+    assert!(err.contains("unsupported pixel type"), "{err}");
+    assert!(source.next().is_none());
+}
+
+#[test]
+fn glob_pattern_selects_matching_files() {
+    let dir = tempfile::tempdir().unwrap();
+    for i in 0..4 {
+        gray8(&dir.path().join(format!("img{i}.png")), 3, 3, i as u8);
+    }
+    gray8(&dir.path().join("other.jpg"), 3, 3, 0);
+    let pattern = format!("{}/img*.png", dir.path().display());
+    let source = open_frames(&pattern, &FrameOptions::default()).unwrap();
+    assert_eq!(source.len(), Some(4));
+    assert_eq!(source.count(), 4);
+
+    let none = format!("{}/*.tif", dir.path().display());
+    let err = open_frames(&none, &FrameOptions::default()).unwrap_err();
+    assert!(
+        err.to_string().contains("no frames found matching"),
+        "{err}"
+    );
+}
+
+#[test]
+fn missing_and_empty_inputs_fail_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nope");
+    match open(&missing).unwrap_err() {
+        Error::Io { path, cause, hint } => {
+            assert_eq!(path, missing);
+            assert_eq!(cause.kind(), std::io::ErrorKind::NotFound);
+            assert!(hint.contains("folder of frames"));
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    let err = open(dir.path()).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        format!(
+            "no frames found in {}; expected .tif/.png/.jpg files",
+            dir.path().display()
+        )
+    );
+    let text = dir.path().join("x.txt");
+    std::fs::write(&text, "hello").unwrap();
+    assert!(
+        open(&text)
+            .unwrap_err()
+            .to_string()
+            .contains("unsupported input")
+    );
+}
+
+#[test]
+fn corrupt_tiff_in_the_middle_comes_after_the_good_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    for i in [1, 2, 4] {
+        tiff16_pages(&dir.path().join(format!("s_{i}.tif")), 4, 4, &[i * 1000]);
+    }
+    let bad = dir.path().join("s_3.tif");
+    std::fs::write(&bad, b"II*\0 this is not really a tiff").unwrap();
+    let mut source = open(dir.path()).unwrap();
+    assert_eq!(source.next().unwrap().unwrap().index, 0);
+    assert_eq!(source.next().unwrap().unwrap().index, 1);
+    match source.next().unwrap().unwrap_err() {
+        Error::Frame {
+            path,
+            frame,
+            message,
+        } => {
+            assert_eq!(path, bad);
+            assert_eq!(frame, 2);
+            assert!(message.starts_with("cannot decode: "), "{message}");
+            assert!(message.ends_with("remove or replace the file"), "{message}");
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    assert!(source.next().is_none());
+}
+
+#[test]
+fn frames_of_different_sizes_are_refused_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    gray8(&dir.path().join("a1.png"), 8, 6, 1);
+    gray8(&dir.path().join("a2.png"), 7, 6, 1);
+    let mut source = open(dir.path()).unwrap();
+    assert!(source.next().unwrap().is_ok());
+    let err = source.next().unwrap().unwrap_err();
+    let text = err.to_string();
+    assert!(matches!(err, Error::Frame { frame: 1, .. }));
+    assert!(text.contains("7×6") && text.contains("8×6"), "{text}");
+}
+
+#[test]
+fn dropping_the_source_early_stops_the_reader() {
+    let dir = tempfile::tempdir().unwrap();
+    for i in 0..40 {
+        gray8(&dir.path().join(format!("{i:03}.png")), 64, 64, i as u8);
+    }
+    let input = dir.path().to_str().unwrap().to_owned();
+    let (done, finished) = crossbeam_channel::bounded(1);
+    std::thread::spawn(move || {
+        let options = FrameOptions {
+            read_ahead: 2,
+            ..FrameOptions::default()
+        };
+        let mut source = open_frames(&input, &options).unwrap();
+        let first = source.next().unwrap().unwrap();
+        drop(source);
+        done.send(first.index).unwrap();
+    });
+    let index = finished
+        .recv_timeout(Duration::from_secs(20))
+        .expect("dropping the frame source hung");
+    assert_eq!(index, 0);
+}
+
+#[test]
+fn read_image_reads_a_mask_and_names_bad_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mask.png");
+    gray8(&path, 3, 2, 255);
+    let mask = read_image(&path).unwrap();
+    assert_eq!(mask.dimensions(), (3, 2));
+    assert_eq!(mask.get(2, 1), 1.0);
+    let bad = dir.path().join("bad.png");
+    std::fs::write(&bad, b"garbage").unwrap();
+    let err = read_image(&bad).unwrap_err().to_string();
+    assert!(
+        err.contains("bad.png") && err.contains("cannot decode"),
+        "{err}"
+    );
+    assert!(matches!(
+        read_image(dir.path().join("none.png")),
+        Err(Error::Io { .. })
+    ));
+}

@@ -1,0 +1,291 @@
+//! Track tables: round trips for every format, TracTrac's exact header, hand-made TracTrac
+//! files, partial files, and errors that name the line.
+
+use std::path::Path;
+
+use sillage_core::{Point2, TrackPoint, Vec2};
+use sillage_io::{
+    TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, create_track_writer, read_tracks,
+};
+
+fn sample_points(n: u64) -> Vec<TrackPoint> {
+    (0..n)
+        .map(|i| {
+            let mut p = TrackPoint::at(
+                i / 3,
+                70_000 + i % 3,
+                Point2::new(i as f64 * 1.25 + 0.123456, 7.0 - i as f64 / 7.0),
+            );
+            if i % 2 == 0 {
+                p.vel_px_per_frame = Some(Vec2::new(0.5 + i as f64 * 1e-3, -0.25));
+                p.acc_px_per_frame2 = Some(Vec2::new(0.01, 0.02));
+                p.vel_pred_px_per_frame = Some(Vec2::new(0.49, -0.26));
+                p.log10_pred_err = Some(-1.2345);
+            }
+            p
+        })
+        .collect()
+}
+
+fn header() -> TrackFileHeader {
+    TrackFileHeader {
+        program_version: "3.0 (sillage 0.1.0)".into(),
+        parameters: vec![
+            ("peak_th".into(), "0.02".into()),
+            ("tracker".into(), "ptv".into()),
+        ],
+    }
+}
+
+fn write(path: &Path, format: TrackFormat, points: &[TrackPoint]) {
+    let mut writer = create_track_writer(path, format, &header()).unwrap();
+    for chunk in points.chunks(4) {
+        writer.accept(chunk).unwrap();
+    }
+    let summary = writer.finish().unwrap();
+    assert_eq!(summary.rows, points.len() as u64);
+    assert_eq!(summary.path, path);
+}
+
+fn assert_close(a: &[TrackPoint], b: &[TrackPoint], tol: f64) {
+    assert_eq!(a.len(), b.len());
+    let close = |x: f64, y: f64| (x - y).abs() <= tol;
+    let close_v = |x: Option<Vec2>, y: Option<Vec2>| match (x, y) {
+        (Some(x), Some(y)) => close(x.x, y.x) && close(x.y, y.y),
+        (None, None) => true,
+        _ => false,
+    };
+    for (p, q) in a.iter().zip(b) {
+        assert_eq!((p.frame, p.track_id), (q.frame, q.track_id));
+        assert!(
+            close(p.pos_px.x, q.pos_px.x) && close(p.pos_px.y, q.pos_px.y),
+            "{p:?} {q:?}"
+        );
+        assert!(
+            close_v(p.vel_px_per_frame, q.vel_px_per_frame),
+            "{p:?} {q:?}"
+        );
+        assert!(
+            close_v(p.acc_px_per_frame2, q.acc_px_per_frame2),
+            "{p:?} {q:?}"
+        );
+        assert!(
+            close_v(p.vel_pred_px_per_frame, q.vel_pred_px_per_frame),
+            "{p:?} {q:?}"
+        );
+        match (p.log10_pred_err, q.log10_pred_err) {
+            (Some(x), Some(y)) => assert!(close(x, y)),
+            (x, y) => assert_eq!(x, y),
+        }
+    }
+}
+
+#[test]
+fn tractrac_round_trip_within_its_decimals() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("seq_track.txt");
+    let points = sample_points(20);
+    write(&path, TrackFormat::Tractrac, &points);
+    assert_close(
+        &read_tracks(&path, TrackFormat::Tractrac).unwrap(),
+        &points,
+        5e-4,
+    );
+}
+
+#[test]
+fn csv_round_trip_is_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("tracks.csv");
+    let points = sample_points(20);
+    write(&path, TrackFormat::Csv, &points);
+    assert_eq!(read_tracks(&path, TrackFormat::Csv).unwrap(), points);
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.starts_with("frame,particle,x,y,vx,vy,ax,ay,vx_pred,vy_pred,log_err\n"));
+}
+
+#[cfg(feature = "parquet")]
+#[test]
+fn parquet_round_trip_is_exact_across_row_groups() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("tracks.parquet");
+    let points = sample_points(150_000);
+    let mut writer = create_track_writer(&path, TrackFormat::Parquet, &header()).unwrap();
+    for chunk in points.chunks(1000) {
+        writer.accept(chunk).unwrap();
+    }
+    assert_eq!(writer.finish().unwrap().rows, 150_000);
+    assert_eq!(read_tracks(&path, TrackFormat::Parquet).unwrap(), points);
+}
+
+#[cfg(feature = "hdf5")]
+#[test]
+fn hdf5_round_trip_is_exact_with_large_ids() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("tracks.h5");
+    let points = sample_points(70_000);
+    let mut writer = create_track_writer(&path, TrackFormat::Hdf5, &header()).unwrap();
+    for chunk in points.chunks(5000) {
+        writer.accept(chunk).unwrap();
+    }
+    assert_eq!(writer.finish().unwrap().rows, 70_000);
+    assert!(!dir.path().join(".tracks.h5.partial").exists());
+    assert_eq!(read_tracks(&path, TrackFormat::Hdf5).unwrap(), points);
+}
+
+#[test]
+fn tractrac_header_is_exactly_tractracs() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("seq_track.txt");
+    let mut point = TrackPoint::at(1, 0, Point2::new(12.0, 3.5));
+    point.vel_px_per_frame = Some(Vec2::new(1.0, -0.5));
+    write(&path, TrackFormat::Tractrac, &[point]);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "# TracTrac v3.0 (sillage 0.1.0) ");
+    assert_eq!(
+        lines[1],
+        "#  Parameters: {'peak_th': 0.02, 'tracker': 'ptv'}"
+    );
+    assert_eq!(
+        lines[2],
+        "#  Frame ID x y Vx Vy Ax Ay Vx(prediction) Vy(prediction) Error(prediction)"
+    );
+    assert_eq!(lines[2], format!("#  {TRACTRAC_COLUMNS_LINE}"));
+    assert_eq!(
+        lines[3],
+        "1 0 12.000 3.500 1.00000 -0.50000 nan nan nan nan nan"
+    );
+    assert_eq!(lines.len(), 4);
+}
+
+#[test]
+fn hand_made_tractrac_file_is_read() {
+    // As numpy.savetxt writes it from TracTrac v3.0 (one row per tracklet per frame).
+    let text = "# TracTrac v3.0 (22/05/2021) | J. Heyman \n\
+#  Parameters: {'vid_loop': 2.0, 'peak_th': 0.02, 'ROIxmin': 0}\n\
+#  Frame ID x y Vx Vy Ax Ay Vx(prediction) Vy(prediction) Error(prediction)\n\
+1 0 101.234 55.500 1.20000 -0.30000 0.0100 -0.0200 1.1900 -0.2900 -1.523\n\
+1 1 12.000 13.000 nan nan nan nan 0.0000 0.0000 -10.000\n\
+\n\
+2 0 102.434 55.200 1.20000 -0.30000 0.0000 0.0000 1.2000 -0.3000 -2.000\n";
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("videotest_track.txt");
+    std::fs::write(&path, text).unwrap();
+    let points = read_tracks(&path, TrackFormat::from_path(&path).unwrap()).unwrap();
+    assert_eq!(points.len(), 3);
+    assert_eq!((points[0].frame, points[0].track_id), (1, 0));
+    assert_eq!(points[0].pos_px, Point2::new(101.234, 55.5));
+    assert_eq!(points[0].vel_px_per_frame, Some(Vec2::new(1.2, -0.3)));
+    assert_eq!(points[0].log10_pred_err, Some(-1.523));
+    assert_eq!(points[1].vel_px_per_frame, None);
+    assert_eq!(points[1].acc_px_per_frame2, None);
+    assert_eq!(points[1].vel_pred_px_per_frame, Some(Vec2::new(0.0, 0.0)));
+    assert_eq!(points[2].frame, 2);
+}
+
+#[test]
+fn tractrac_errors_name_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad_track.txt");
+    std::fs::write(
+        &path,
+        "# header\n1 0 1 2 0 0 0 0 0 0 0\n2 0 nan 2 0 0 0 0 0 0 0\n",
+    )
+    .unwrap();
+    let err = read_tracks(&path, TrackFormat::Tractrac)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("bad_track.txt:3:") && err.contains("not finite"),
+        "{err}"
+    );
+    std::fs::write(&path, "1 0 1 2 0 0 0\n").unwrap();
+    let err = read_tracks(&path, TrackFormat::Tractrac)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(":1:") && err.contains("7 columns instead of 11"),
+        "{err}"
+    );
+}
+
+#[test]
+fn csv_errors_name_the_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.csv");
+    std::fs::write(&path, "frame,particle,x,y\n0,1,2.0,3.0\n1,1,NaN,3.0\n").unwrap();
+    let err = read_tracks(&path, TrackFormat::Csv)
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with(&format!("{}:3:", path.display())), "{err}");
+    assert!(err.contains("`x`"), "{err}");
+    std::fs::write(&path, "frame,x,y\n0,2.0,3.0\n").unwrap();
+    let err = read_tracks(&path, TrackFormat::Csv)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(":1:") && err.contains("missing column `particle`"),
+        "{err}"
+    );
+    std::fs::write(&path, "frame,particle,x,y\n0,1,2.0\n").unwrap();
+    let err = read_tracks(&path, TrackFormat::Csv)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains(":2:") && err.contains("fields"), "{err}");
+    std::fs::write(&path, "frame,particle,x,y\n-1,1,2.0,3\n").unwrap();
+    let err = read_tracks(&path, TrackFormat::Csv)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(":2:") && err.contains("`frame` = `-1`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn trackpy_style_csv_without_kinematics_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("trackpy.csv");
+    std::fs::write(&path, "y,x,frame,particle\n3.5,2.25,4,9\n").unwrap();
+    let points = read_tracks(&path, TrackFormat::Csv).unwrap();
+    assert_eq!(points, vec![TrackPoint::at(4, 9, Point2::new(2.25, 3.5))]);
+}
+
+#[test]
+fn unfinished_writer_leaves_complete_rows_in_the_partial_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.csv");
+    let mut writer = create_track_writer(&path, TrackFormat::Csv, &header()).unwrap();
+    writer.accept(&sample_points(3)).unwrap();
+    drop(writer);
+    assert!(!path.exists());
+    let partial = std::fs::read_to_string(dir.path().join(".run.csv.partial")).unwrap();
+    assert_eq!(partial.lines().count(), 4);
+    assert!(partial.ends_with('\n'));
+}
+
+#[test]
+fn formats_from_paths_and_names() {
+    let from = |p: &str| TrackFormat::from_path(Path::new(p)).unwrap();
+    assert_eq!(from("a/seq_track.txt"), TrackFormat::Tractrac);
+    assert_eq!(from("a.CSV"), TrackFormat::Csv);
+    assert_eq!(from("a.parquet"), TrackFormat::Parquet);
+    assert_eq!(from("a.h5"), TrackFormat::Hdf5);
+    assert_eq!(from("a.hdf5"), TrackFormat::Hdf5);
+    assert!(TrackFormat::from_path(Path::new("a.xlsx")).is_err());
+    for format in TrackFormat::ALL {
+        assert_eq!(format.to_string().parse::<TrackFormat>().unwrap(), format);
+    }
+    let err = "xml".parse::<TrackFormat>().unwrap_err().to_string();
+    assert!(err.contains("`format` = xml"), "{err}");
+}
+
+#[test]
+fn non_finite_positions_are_refused_by_writers() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.csv");
+    let mut writer = create_track_writer(&path, TrackFormat::Csv, &header()).unwrap();
+    let bad = TrackPoint::at(0, 1, Point2::new(f64::NAN, 0.0));
+    assert!(writer.accept(&[bad]).is_err());
+}

@@ -1,0 +1,22 @@
+//! TracTrac-class particle tracking velocimetry (Heyman, TracTrac, §3.1.2–3.1.4).
+//!
+//! At each new frame t, [`PtvTracker`]:
+//! 1. predicts where the points of frame t−1 go, `x + U·dt`, with a motion model averaged
+//!    over the k nearest velocity samples (Eqs. 8–9; `U = 0` until two samples exist);
+//! 2. keeps the mutual nearest-neighbour pairs between the predictions and frame t;
+//! 3. makes a tracklet of every point of frame t−1 paired both backwards (t−2 ↔ t−1) and
+//!    forwards (t−1 ↔ t), with central-difference kinematics (Eqs. 6–7);
+//! 4. rejects tracklets whose log prediction error is an outlier (Eqs. 10–12);
+//! 5. hands track ids over from link to link (§3.1.4) and emits frame t−1.
+//!
+//! It follows what TracTrac's Python code does where it differs from the paper's text; each
+//! function says where. Training passes (TracTrac's `vid_loop`) are driven by the caller
+//! through [`PtvTracker::start_pass`].
+
+mod filter;
+mod motion;
+mod params;
+mod tracker;
+
+pub use params::PtvParams;
+pub use tracker::{PassDirection, PtvTracker};

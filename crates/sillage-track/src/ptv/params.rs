@@ -1,0 +1,158 @@
+//! Parameters of the PTV tracker, with TracTrac's defaults.
+
+use serde::{Deserialize, Serialize};
+use sillage_core::{Error, Result};
+
+/// Parameters of [`crate::ptv::PtvTracker`]. Keys and defaults are those of TracTrac's
+/// parameter file as its command line fills them in (`set_default_parameter`), so a
+/// TracTrac `*_par.txt` maps one to one; `max_displacement_px` and `dt` are additions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PtvParams {
+    /// Use the motion model to predict positions before associating (default `true`).
+    pub motion: bool,
+    /// k, the number of nearest model samples averaged (Eq. 8); default 10.
+    pub motion_av: usize,
+    /// Extra predict–associate iterations per frame, the model rebuilt from the frame's own
+    /// tracklets (§3.1.2 "iterative sequence"); default 0.
+    pub motion_it: usize,
+    /// Reject tracklets whose prediction error is an outlier (§3.1.3); default `true`.
+    pub filter: bool,
+    /// n_σ of the outlier test on the log10 error (§3.1.3); default 1.5. May be negative.
+    pub filter_std: f64,
+    /// Memory weight of the motion model and of the threshold (TracTrac's relaxation weight;
+    /// the paper's α ≈ 1 / (1 + filter_time)); default 1.0.
+    pub filter_time: f64,
+    /// Reject pairs whose displacement exceeds this many px (TracTrac has no such gate);
+    /// default `None`.
+    pub max_displacement_px: Option<f64>,
+    /// Time between frames in the unit velocities are reported in; 1.0 gives px/frame.
+    pub dt: f64,
+}
+
+impl Default for PtvParams {
+    fn default() -> Self {
+        Self {
+            motion: true,
+            motion_av: 10,
+            motion_it: 0,
+            filter: true,
+            filter_std: 1.5,
+            filter_time: 1.0,
+            max_displacement_px: None,
+            dt: 1.0,
+        }
+    }
+}
+
+/// Largest accepted `motion_it` (each iteration costs a full association).
+const MAX_MOTION_IT: usize = 100;
+
+impl PtvParams {
+    /// Checks every value; the error names the key and its allowed range.
+    pub fn validate(&self) -> Result<()> {
+        if self.motion_av == 0 {
+            return Err(Error::parameter(
+                "motion_av",
+                self.motion_av,
+                "must be an integer ≥ 1 (number of neighbours averaged; TracTrac uses 10)",
+            ));
+        }
+        if self.motion_it > MAX_MOTION_IT {
+            return Err(Error::parameter(
+                "motion_it",
+                self.motion_it,
+                format!("must be an integer in 0..={MAX_MOTION_IT}"),
+            ));
+        }
+        if !self.filter_std.is_finite() {
+            return Err(Error::parameter(
+                "filter_std",
+                self.filter_std,
+                "must be a finite number (n_σ, typically 1.5)",
+            ));
+        }
+        if !(self.filter_time.is_finite() && self.filter_time >= 0.0) {
+            return Err(Error::parameter(
+                "filter_time",
+                self.filter_time,
+                "must be a finite number ≥ 0 (typically 1)",
+            ));
+        }
+        if let Some(gate) = self.max_displacement_px
+            && !(gate.is_finite() && gate > 0.0)
+        {
+            return Err(Error::parameter(
+                "max_displacement_px",
+                gate,
+                "must be a finite number > 0, or absent for no gate",
+            ));
+        }
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(Error::parameter(
+                "dt",
+                self.dt,
+                "must be a finite number > 0 (backward passes negate it themselves)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_errors_name_the_key() {
+        PtvParams::default().validate().unwrap();
+        let cases = [
+            (
+                "motion_av",
+                PtvParams {
+                    motion_av: 0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "motion_it",
+                PtvParams {
+                    motion_it: 1000,
+                    ..Default::default()
+                },
+            ),
+            (
+                "filter_std",
+                PtvParams {
+                    filter_std: f64::NAN,
+                    ..Default::default()
+                },
+            ),
+            (
+                "filter_time",
+                PtvParams {
+                    filter_time: -1.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "max_displacement_px",
+                PtvParams {
+                    max_displacement_px: Some(0.0),
+                    ..Default::default()
+                },
+            ),
+            (
+                "dt",
+                PtvParams {
+                    dt: 0.0,
+                    ..Default::default()
+                },
+            ),
+        ];
+        for (key, params) in cases {
+            let message = params.validate().unwrap_err().to_string();
+            assert!(message.contains(&format!("`{key}`")), "{message}");
+        }
+    }
+}

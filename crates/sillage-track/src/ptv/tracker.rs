@@ -1,0 +1,377 @@
+//! The PTV tracker: three-frame association, kinematics, outlier filter, id hand-over.
+
+use sillage_assoc::{Neighbour, NeighbourIndex, PointIndex, mutual_pairs};
+use sillage_core::{
+    Error, FrameIndex, FrameObservations, MotionState, Point2, Result, TrackId, TrackPoint,
+    TrackSink, Tracker, Vec2,
+};
+
+use super::filter::{INITIAL_THRESHOLD, log10_error, updated_threshold};
+use super::motion::{MotionField, Samples};
+use super::params::PtvParams;
+
+/// Direction of a pass over the sequence (TracTrac's `vid_loop` alternates them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PassDirection {
+    /// Frames arrive in increasing order; time step `+dt`.
+    #[default]
+    Forward,
+    /// Frames arrive in decreasing order; time step `−dt`, so velocities keep their
+    /// forward-in-time sign and the motion model stays valid.
+    Backward,
+}
+
+/// One point of frame t−1 linked backwards and forwards: a candidate tracklet.
+#[derive(Debug, Clone, Copy)]
+struct Triplet {
+    /// Index in frame t−2.
+    before: usize,
+    /// Index in frame t−1 (the middle, emitted frame).
+    middle: usize,
+    vel: Vec2,
+    acc: Vec2,
+    log_err: f64,
+    kept: bool,
+}
+
+/// TracTrac's tracker (see the [module docs](super)): emits the points of frame t−1 at the
+/// step of frame t, in increasing track id order, with the central-difference velocity
+/// (Eq. 6), the acceleration (Eq. 7), the motion-model velocity (Eq. 8) and the log10
+/// prediction error (Eq. 10).
+///
+/// `finish` has nothing to flush: the first and the last frame of a pass are never the
+/// middle of a triplet (TracTrac also outputs frames 1..n−2 only), and every other frame
+/// was emitted as soon as its successor arrived.
+///
+/// Training passes: [`PtvTracker::start_pass`] starts a new pass over the same sequence,
+/// keeping the motion model and the outlier threshold. The caller (the facade) drives them,
+/// e.g. TracTrac's `vid_loop = 2`: Forward over frames 0..n, Backward over n−1..=0, then
+/// Forward again, keeping only the last pass's output (give the training passes a sink that
+/// discards). Each pass restarts track ids at 0.
+///
+/// Deterministic: no random tie-break (nearest-neighbour ties go to the lower index), and
+/// parallel work is per point with sequential reductions, so the output is the same bit for
+/// bit whatever the number of rayon threads.
+#[derive(Debug, Clone)]
+pub struct PtvTracker {
+    params: PtvParams,
+    direction: PassDirection,
+    /// Frames received in this pass, capped at 2 (then every frame makes a full step).
+    frames_in_pass: u8,
+    /// Frame index of `c1`.
+    frame_c1: FrameIndex,
+    // Positions of frames t−2, t−1 and t, and raw indexes of t−1 and t.
+    c0: Vec<Point2>,
+    c1: Vec<Point2>,
+    c2: Vec<Point2>,
+    index_c1: PointIndex,
+    index_c2: PointIndex,
+    index_pred: PointIndex,
+    /// Per point of `c1`: its mutual partner in `c0`.
+    link01: Vec<Option<usize>>,
+    /// Per point of `c0`: the track id its tracklet handed over.
+    ids0: Vec<Option<TrackId>>,
+    next_id: TrackId,
+    // Learned state, kept across passes.
+    /// Good tracklets of the previous step (model samples of weight 1).
+    recent: Samples,
+    /// Model stored at the previous step (samples of weight `filter_time`).
+    stored: Samples,
+    threshold: f64,
+    // Buffers reused from frame to frame.
+    field: MotionField,
+    next_stored: Samples,
+    current: Samples,
+    vel_pred: Vec<Vec2>,
+    log_err_pred: Vec<f64>,
+    pred: Vec<Point2>,
+    forward: Vec<Option<Neighbour>>,
+    backward: Vec<Option<Neighbour>>,
+    link12: Vec<Option<usize>>,
+    link21: Vec<Option<usize>>,
+    triplets: Vec<Triplet>,
+    errors: Vec<f64>,
+    ids1: Vec<Option<TrackId>>,
+    emitted: Vec<TrackPoint>,
+}
+
+impl PtvTracker {
+    /// A tracker with validated `params`, starting a forward pass.
+    pub fn new(params: PtvParams) -> Result<Self> {
+        params.validate()?;
+        Ok(Self {
+            field: MotionField::new(params.motion_av, params.filter_time),
+            params,
+            direction: PassDirection::Forward,
+            frames_in_pass: 0,
+            frame_c1: 0,
+            c0: Vec::new(),
+            c1: Vec::new(),
+            c2: Vec::new(),
+            index_c1: PointIndex::default(),
+            index_c2: PointIndex::default(),
+            index_pred: PointIndex::default(),
+            link01: Vec::new(),
+            ids0: Vec::new(),
+            next_id: 0,
+            recent: Samples::default(),
+            stored: Samples::default(),
+            threshold: INITIAL_THRESHOLD,
+            next_stored: Samples::default(),
+            current: Samples::default(),
+            vel_pred: Vec::new(),
+            log_err_pred: Vec::new(),
+            pred: Vec::new(),
+            forward: Vec::new(),
+            backward: Vec::new(),
+            link12: Vec::new(),
+            link21: Vec::new(),
+            triplets: Vec::new(),
+            errors: Vec::new(),
+            ids1: Vec::new(),
+            emitted: Vec::new(),
+        })
+    }
+
+    /// The parameters in use.
+    pub fn params(&self) -> &PtvParams {
+        &self.params
+    }
+
+    /// Starts a new pass over the sequence in `direction` (TracTrac's `vid_loop`): forgets
+    /// the frames and track ids of the current pass, keeps the motion model and the outlier
+    /// threshold it has learned. In a `Backward` pass frames must arrive in decreasing order.
+    pub fn start_pass(&mut self, direction: PassDirection) {
+        self.direction = direction;
+        self.frames_in_pass = 0;
+        self.next_id = 0;
+    }
+
+    /// The time step of this pass, negative when going backwards.
+    fn signed_dt(&self) -> f64 {
+        match self.direction {
+            PassDirection::Forward => self.params.dt,
+            PassDirection::Backward => -self.params.dt,
+        }
+    }
+
+    /// Copies the detections of `obs` into `c2`, checking frame order and positions.
+    fn load_frame(&mut self, obs: &FrameObservations<'_>) -> Result<()> {
+        if self.frames_in_pass > 0 {
+            let (ok, order) = match self.direction {
+                PassDirection::Forward => (obs.frame > self.frame_c1, "increasing"),
+                PassDirection::Backward => (obs.frame < self.frame_c1, "decreasing"),
+            };
+            if !ok {
+                return Err(Error::input(format!(
+                    "frame {} arrived after frame {} in a {:?} pass; frames must come in \
+                     {order} order (call start_pass to change direction)",
+                    obs.frame, self.frame_c1, self.direction
+                )));
+            }
+        }
+        self.c2.clear();
+        for (i, d) in obs.detections.iter().enumerate() {
+            if !d.pos_px.is_finite() {
+                return Err(Error::input(format!(
+                    "frame {}: detection {i} is at ({}, {}); positions must be finite \
+                     (check the detector)",
+                    obs.frame, d.pos_px.x, d.pos_px.y
+                )));
+            }
+            self.c2.push(d.pos_px);
+        }
+        Ok(())
+    }
+
+    /// Predicts `c1 + U·dt` with the model built from `recent` (or the current iteration's
+    /// tracklets) and the stored model; returns whether the model was applied.
+    fn predict(&mut self, from_current: bool, dt: f64) -> bool {
+        let recent = if from_current {
+            &self.current
+        } else {
+            &self.recent
+        };
+        let applied =
+            self.params.motion && recent.len() + self.stored.len() > 1 && !self.c1.is_empty();
+        if applied {
+            self.field.evaluate(
+                &self.c1,
+                recent,
+                &self.stored,
+                &mut self.vel_pred,
+                &mut self.log_err_pred,
+                &mut self.next_stored,
+            );
+        } else {
+            self.vel_pred.clear();
+            self.vel_pred.resize(self.c1.len(), Vec2::ZERO);
+            self.log_err_pred.clear();
+            self.log_err_pred.resize(self.c1.len(), 0.0);
+        }
+        self.pred.clear();
+        self.pred.extend(
+            self.c1
+                .iter()
+                .zip(&self.vel_pred)
+                .map(|(&p, &u)| p + u * dt),
+        );
+        applied
+    }
+
+    /// Mutual nearest neighbours between the predictions and frame t (Eq. 9 then §3.1.2),
+    /// reusing frame t's index; without a model the predictions are frame t−1 itself and
+    /// its index is reused too.
+    fn associate(&mut self, model_applied: bool) {
+        let pred_index = if model_applied {
+            self.index_pred.rebuild(&self.pred);
+            &self.index_pred
+        } else {
+            &self.index_c1
+        };
+        self.index_c2.nearest_batch(&self.pred, &mut self.forward);
+        pred_index.nearest_batch(&self.c2, &mut self.backward);
+        mutual_pairs(&self.forward, &self.backward, None, &mut self.link12);
+        mutual_pairs(&self.backward, &self.forward, None, &mut self.link21);
+        if let Some(gate) = self.params.max_displacement_px {
+            let (c1, c2) = (&self.c1, &self.c2);
+            for (j, link) in self.link12.iter_mut().enumerate() {
+                *link = link.filter(|&k| c1[j].distance(c2[k]) <= gate);
+            }
+            for (k, link) in self.link21.iter_mut().enumerate() {
+                *link = link.filter(|&j| c1[j].distance(c2[k]) <= gate);
+            }
+        }
+    }
+
+    /// Builds the triplets t−2 ↔ t−1 ↔ t, their kinematics and errors, applies the outlier
+    /// test and updates the threshold; the kept ones become `current`.
+    fn make_tracklets(&mut self, dt: f64) {
+        self.triplets.clear();
+        self.errors.clear();
+        self.current.clear();
+        for (middle, (&back, &ahead)) in self.link01.iter().zip(&self.link12).enumerate() {
+            let (Some(before), Some(after)) = (back, ahead) else {
+                continue;
+            };
+            let (x0, x1, x2) = (self.c0[before], self.c1[middle], self.c2[after]);
+            let u0 = (x1 - x0) / dt;
+            let u1 = (x2 - x1) / dt;
+            // Eq. (6): v(t−1) = (x(t) − x(t−2)) / 2Δt, the mean of the two finite differences.
+            let vel = (u0 + u1) * 0.5;
+            // Eq. (7), whose signs were lost in the text: a(t−1) = (x(t) − 2x(t−1) + x(t−2)) / Δt².
+            let acc = (u1 - u0) / dt;
+            let log_err = log10_error(self.vel_pred[middle], vel, dt);
+            // §3.1.3: outlier when ε − ε̄ ≥ threshold (the threshold stands for n_σ·σ̄_ε).
+            let kept = !self.params.filter || log_err - self.log_err_pred[middle] < self.threshold;
+            self.errors.push(log_err);
+            self.triplets.push(Triplet {
+                before,
+                middle,
+                vel,
+                acc,
+                log_err,
+                kept,
+            });
+            if kept {
+                self.current.push(x1, vel, log_err);
+            }
+        }
+        self.threshold = updated_threshold(
+            self.threshold,
+            &self.errors,
+            self.params.filter_std,
+            self.params.filter_time,
+        );
+    }
+
+    /// §3.1.4: each tracklet takes the id of its t−2 ↔ t−1 link; kept tracklets without one
+    /// get a new id; rejected ones still pass an inherited id on. Emits the kept ones.
+    fn hand_over_ids(&mut self, sink: &mut dyn TrackSink) -> Result<()> {
+        self.ids1.clear();
+        self.ids1.resize(self.c1.len(), None);
+        self.emitted.clear();
+        for t in &self.triplets {
+            let mut id = self.ids0[t.before];
+            if id.is_none() && t.kept {
+                id = Some(self.next_id);
+                self.next_id += 1;
+            }
+            self.ids1[t.middle] = id;
+            if let (Some(track_id), true) = (id, t.kept) {
+                self.emitted.push(TrackPoint {
+                    frame: self.frame_c1,
+                    track_id,
+                    pos_px: self.c1[t.middle],
+                    vel_px_per_frame: Some(t.vel),
+                    acc_px_per_frame2: Some(t.acc),
+                    vel_pred_px_per_frame: Some(self.vel_pred[t.middle]),
+                    log10_pred_err: Some(t.log_err),
+                    motion_state: MotionState::Unknown,
+                });
+            }
+        }
+        self.emitted.sort_unstable_by_key(|p| p.track_id);
+        if self.emitted.is_empty() {
+            Ok(())
+        } else {
+            sink.accept(&self.emitted)
+        }
+    }
+
+    /// Frame t becomes t−1: rotates positions, indexes, links and ids.
+    fn shift(&mut self, frame: FrameIndex) {
+        std::mem::swap(&mut self.c0, &mut self.c1);
+        std::mem::swap(&mut self.c1, &mut self.c2);
+        std::mem::swap(&mut self.index_c1, &mut self.index_c2);
+        std::mem::swap(&mut self.link01, &mut self.link21);
+        std::mem::swap(&mut self.ids0, &mut self.ids1);
+        self.frame_c1 = frame;
+    }
+}
+
+impl Tracker for PtvTracker {
+    fn step(&mut self, obs: &FrameObservations<'_>, sink: &mut dyn TrackSink) -> Result<()> {
+        self.load_frame(obs)?;
+        let dt = self.signed_dt();
+        match self.frames_in_pass {
+            0 => {
+                std::mem::swap(&mut self.c1, &mut self.c2);
+                self.index_c1.rebuild(&self.c1);
+                self.frame_c1 = obs.frame;
+            }
+            1 => {
+                // First link of the pass (TracTrac's initialisation): frame 0 ↔ frame 1,
+                // predicted with whatever model earlier passes learned, which stays stored.
+                self.index_c2.rebuild(&self.c2);
+                let applied = self.predict(false, dt);
+                self.associate(applied);
+                self.ids1.clear();
+                self.ids1.resize(self.c1.len(), None);
+                self.shift(obs.frame);
+            }
+            _ => {
+                self.index_c2.rebuild(&self.c2);
+                let mut model_updated = false;
+                for it in 0..=self.params.motion_it {
+                    let applied = self.predict(it > 0, dt);
+                    model_updated |= applied;
+                    self.associate(applied);
+                    self.make_tracklets(dt);
+                }
+                if model_updated {
+                    std::mem::swap(&mut self.stored, &mut self.next_stored);
+                }
+                self.hand_over_ids(sink)?;
+                std::mem::swap(&mut self.recent, &mut self.current);
+                self.shift(obs.frame);
+            }
+        }
+        self.frames_in_pass = (self.frames_in_pass + 1).min(2);
+        Ok(())
+    }
+
+    fn finish(&mut self, _sink: &mut dyn TrackSink) -> Result<()> {
+        Ok(())
+    }
+}

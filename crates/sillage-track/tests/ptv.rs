@@ -1,0 +1,441 @@
+//! PTV tracker on small seeded synthetic scenes with known truth.
+
+use std::collections::HashMap;
+
+use rand::RngExt;
+use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker, Vec2, rng_stream};
+use sillage_track::ptv::{PassDirection, PtvParams, PtvTracker};
+
+/// Detections per frame and the true particle id of each detection.
+struct Scene {
+    frames: Vec<Vec<Detection>>,
+    truth: Vec<Vec<u64>>,
+}
+
+impl Scene {
+    /// `n` particles whose position at frame `f` is `path(initial, f)`; each detection is
+    /// kept with probability `detect_prob`, and `spurious` one-frame points are added.
+    fn new(
+        seed: u64,
+        n: usize,
+        frames: usize,
+        mut initial: impl FnMut(&mut sillage_core::RngStream) -> Point2,
+        path: impl Fn(Point2, f64) -> Point2,
+        detect_prob: f64,
+        spurious: usize,
+    ) -> Self {
+        let mut rng = rng_stream(seed, 0);
+        let starts: Vec<Point2> = (0..n).map(|_| initial(&mut rng)).collect();
+        let mut scene = Scene {
+            frames: Vec::new(),
+            truth: Vec::new(),
+        };
+        let mut next_spurious = n as u64;
+        for f in 0..frames {
+            let (mut dets, mut ids) = (Vec::new(), Vec::new());
+            for (id, &p0) in starts.iter().enumerate() {
+                if rng.random::<f64>() < detect_prob {
+                    dets.push(Detection::new(path(p0, f as f64), 1.0));
+                    ids.push(id as u64);
+                }
+            }
+            for _ in 0..spurious {
+                dets.push(Detection::new(initial(&mut rng), 1.0));
+                ids.push(next_spurious);
+                next_spurious += 1;
+            }
+            scene.frames.push(dets);
+            scene.truth.push(ids);
+        }
+        scene
+    }
+
+    /// Feeds the frames in `direction` to `tracker` and returns what it emitted.
+    fn feed(&self, tracker: &mut PtvTracker, direction: PassDirection) -> Vec<TrackPoint> {
+        tracker.start_pass(direction);
+        let mut out = Vec::new();
+        let mut order: Vec<usize> = (0..self.frames.len()).collect();
+        if direction == PassDirection::Backward {
+            order.reverse();
+        }
+        for f in order {
+            let obs = FrameObservations::from_detections(f as u64, &self.frames[f]);
+            tracker.step(&obs, &mut out).unwrap();
+        }
+        tracker.finish(&mut out).unwrap();
+        out
+    }
+
+    fn track(&self, params: PtvParams) -> Vec<TrackPoint> {
+        self.feed(
+            &mut PtvTracker::new(params).unwrap(),
+            PassDirection::Forward,
+        )
+    }
+
+    /// True id of an emitted point (looked up by its exact position).
+    fn true_ids(&self) -> HashMap<(u64, u64, u64), u64> {
+        let mut map = HashMap::new();
+        for (f, (dets, ids)) in self.frames.iter().zip(&self.truth).enumerate() {
+            for (d, &id) in dets.iter().zip(ids) {
+                map.insert((f as u64, d.pos_px.x.to_bits(), d.pos_px.y.to_bits()), id);
+            }
+        }
+        map
+    }
+
+    /// (recall, precision) of frame-to-frame links: a link is two points of one track in
+    /// consecutive frames; it is correct when both belong to the same true particle. Recall
+    /// counts against the true links between frames 1..n−2, where tracking is possible.
+    fn link_scores(&self, points: &[TrackPoint]) -> (f64, f64) {
+        let ids = self.true_ids();
+        let mut by_track: HashMap<u64, Vec<(u64, u64)>> = HashMap::new();
+        for p in points {
+            let key = (p.frame, p.pos_px.x.to_bits(), p.pos_px.y.to_bits());
+            by_track
+                .entry(p.track_id)
+                .or_default()
+                .push((p.frame, ids[&key]));
+        }
+        let (mut links, mut correct) = (0usize, 0usize);
+        for track in by_track.values_mut() {
+            track.sort();
+            for w in track.windows(2) {
+                if w[1].0 == w[0].0 + 1 {
+                    links += 1;
+                    correct += usize::from(w[0].1 == w[1].1);
+                }
+            }
+        }
+        let last = self.frames.len() - 2;
+        let mut possible = 0usize;
+        for f in 1..last {
+            let next: std::collections::HashSet<_> = self.truth[f + 1].iter().collect();
+            possible += self.truth[f].iter().filter(|id| next.contains(id)).count();
+        }
+        (
+            correct as f64 / possible.max(1) as f64,
+            correct as f64 / links.max(1) as f64,
+        )
+    }
+}
+
+/// Points on a square lattice of `pitch` px, 20 columns wide, each jittered by up to a
+/// quarter pitch: random, yet never closer than half a pitch (uniform random points have
+/// close pairs that no tracker can tell apart in the first, model-free step).
+fn jittered_lattice(pitch: f64) -> impl FnMut(&mut sillage_core::RngStream) -> Point2 {
+    let mut next = 0usize;
+    move |rng| {
+        let (col, row) = ((next % 20) as f64, (next / 20) as f64);
+        next += 1;
+        let jitter = |rng: &mut sillage_core::RngStream| rng.random_range(-0.25..0.25) * pitch;
+        Point2::new(pitch * col + jitter(rng), pitch * row + jitter(rng))
+    }
+}
+
+/// Solid-body rotation about (300, 300) of particles in a disk of 250 px, spinning up
+/// linearly from rest to `omega` rad/frame over `ramp` frames (0: at full speed at once).
+fn rotating(
+    seed: u64,
+    n: usize,
+    (omega, ramp): (f64, f64),
+    frames: usize,
+    detect_prob: f64,
+    spurious: usize,
+) -> Scene {
+    let in_disk = |rng: &mut sillage_core::RngStream| loop {
+        let p = Point2::new(
+            rng.random_range(-250.0..250.0),
+            rng.random_range(-250.0..250.0),
+        );
+        if p.x.hypot(p.y) < 250.0 {
+            return Point2::new(300.0 + p.x, 300.0 + p.y);
+        }
+    };
+    let path = move |p: Point2, t: f64| {
+        let angle = if t < ramp {
+            omega * t * t / (2.0 * ramp)
+        } else {
+            omega * (t - ramp / 2.0)
+        };
+        let (s, c) = angle.sin_cos();
+        let (x, y) = (p.x - 300.0, p.y - 300.0);
+        Point2::new(300.0 + c * x - s * y, 300.0 + s * x + c * y)
+    };
+    Scene::new(seed, n, frames, in_disk, path, detect_prob, spurious)
+}
+
+#[test]
+fn uniform_translation_gives_one_id_per_particle_and_exact_velocities() {
+    let vel = Vec2::new(1.5, -0.7);
+    let scene = Scene::new(
+        1,
+        400,
+        15,
+        jittered_lattice(50.0),
+        |p, t| p + vel * t,
+        1.0,
+        0,
+    );
+    let points = scene.track(PtvParams::default());
+    assert_eq!(points.len(), 400 * 13, "every particle in frames 1..=13");
+    let ids = scene.true_ids();
+    let mut track_of: HashMap<u64, u64> = HashMap::new();
+    for p in &points {
+        let truth = ids[&(p.frame, p.pos_px.x.to_bits(), p.pos_px.y.to_bits())];
+        assert_eq!(*track_of.entry(truth).or_insert(p.track_id), p.track_id);
+        let v = p.vel_px_per_frame.unwrap();
+        assert!((v - vel).max_abs() < 1e-9, "{v:?}");
+        assert!(p.acc_px_per_frame2.unwrap().max_abs() < 1e-9);
+    }
+    assert_eq!(track_of.len(), 400);
+    let mut sorted = points.clone();
+    sorted.sort_by_key(|p| (p.frame, p.track_id));
+    assert_eq!(sorted, points, "frame by frame, in track id order");
+}
+
+#[test]
+fn motion_model_tracks_a_fast_rotation_far_better() {
+    // 3000 particles in a disk of 250 px: spacing √(S/N) ≈ 8.1 px; displacement 0.03·r,
+    // 5 px at the mean radius and 7.5 px at the edge: p⁻¹ ≈ 0.6–0.9.
+    let scene = rotating(2, 3000, (0.03, 0.0), 30, 1.0, 0);
+    let no_model = PtvParams {
+        motion: false,
+        ..Default::default()
+    };
+    let (without, _) = scene.link_scores(&scene.track(no_model));
+    let (one_pass, _) = scene.link_scores(&scene.track(PtvParams::default()));
+    // TracTrac's default `vid_loop = 2`: forward and backward training passes first.
+    let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
+    scene.feed(&mut tracker, PassDirection::Forward);
+    scene.feed(&mut tracker, PassDirection::Backward);
+    let (trained, precision) = scene.link_scores(&scene.feed(&mut tracker, PassDirection::Forward));
+    eprintln!(
+        "recall: no model {without:.3}, one pass {one_pass:.3}, trained {trained:.3} (precision {precision:.4})"
+    );
+    assert!(without < 0.25, "{without}");
+    assert!(one_pass > 2.0 * without, "{one_pass} vs {without}");
+    assert!(trained > 0.9, "{trained}");
+    assert!(precision > 0.98, "{precision}");
+}
+
+#[test]
+fn intermittent_particles_are_rarely_linked_to_others() {
+    // 15 % of detections missing in every frame, plus 100 spurious points per frame.
+    let scene = rotating(3, 2000, (0.02, 0.0), 30, 0.85, 100);
+    let (recall, precision) = scene.link_scores(&scene.track(PtvParams::default()));
+    eprintln!("intermittent: recall {recall:.3}, precision {precision:.4}");
+    assert!(precision > 0.97, "{precision}");
+    assert!(recall > 0.5, "{recall}");
+}
+
+#[test]
+fn constant_acceleration_kinematics_follow_eqs_6_and_7() {
+    let (v, a) = (Vec2::new(2.0, -1.0), Vec2::new(0.1, 0.05));
+    for dt in [1.0, 0.5] {
+        let scene = Scene::new(
+            4,
+            20,
+            12,
+            jittered_lattice(100.0),
+            |p, t| p + v * t + a * (0.5 * t * t),
+            1.0,
+            0,
+        );
+        let params = PtvParams {
+            dt,
+            ..Default::default()
+        };
+        let points = scene.track(params);
+        assert_eq!(points.len(), 20 * 10);
+        for p in points {
+            let t = p.frame as f64;
+            let vel = p.vel_px_per_frame.unwrap();
+            assert!((vel - (v + a * t) / dt).max_abs() < 1e-9, "{vel:?}");
+            assert!((p.acc_px_per_frame2.unwrap() - a / (dt * dt)).max_abs() < 1e-9);
+            assert!(p.vel_pred_px_per_frame.is_some() && p.log10_pred_err.is_some());
+        }
+    }
+}
+
+#[test]
+fn outlier_filter_rejects_an_injected_wrong_link_and_keeps_the_id() {
+    let vel = Vec2::new(1.0, 0.0);
+    let mut scene = Scene::new(
+        5,
+        200,
+        12,
+        jittered_lattice(50.0),
+        |p, t| p + vel * t,
+        1.0,
+        0,
+    );
+    // Particle 0 is detected 5 px off its path in frame 6.
+    scene.frames[6][0].pos_px = scene.frames[6][0].pos_px + Vec2::new(4.0, 3.0);
+    let frames_of_0 = |points: &[TrackPoint]| {
+        let ids = scene.true_ids();
+        let mut seen: Vec<(u64, u64)> = points
+            .iter()
+            .filter(|p| ids[&(p.frame, p.pos_px.x.to_bits(), p.pos_px.y.to_bits())] == 0)
+            .map(|p| (p.frame, p.track_id))
+            .collect();
+        seen.sort();
+        seen
+    };
+    let filtered = frames_of_0(&scene.track(PtvParams::default()));
+    let frames: Vec<u64> = filtered.iter().map(|s| s.0).collect();
+    assert_eq!(
+        frames,
+        vec![1, 2, 3, 4, 6, 8, 9, 10],
+        "frames 5 and 7 link the bad point"
+    );
+    assert!(
+        filtered.iter().all(|s| s.1 == filtered[0].1),
+        "one id throughout: {filtered:?}"
+    );
+    let unfiltered = PtvParams {
+        filter: false,
+        ..Default::default()
+    };
+    assert_eq!(frames_of_0(&scene.track(unfiltered)).len(), 10);
+}
+
+#[test]
+fn output_does_not_depend_on_the_number_of_threads() {
+    let scene = rotating(6, 3000, (0.04, 0.0), 12, 0.9, 50);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let params = PtvParams {
+                motion_it: 1,
+                ..Default::default()
+            };
+            scene.track(params)
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    assert!(!one.is_empty());
+    assert_eq!(format!("{one:?}"), format!("{two:?}"));
+}
+
+#[test]
+fn empty_and_single_point_frames_do_not_panic() {
+    let sizes = [0usize, 1, 0, 1, 1, 2, 0, 0, 3, 1, 1, 1];
+    let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
+    let mut out = Vec::new();
+    for (f, &n) in sizes.iter().enumerate() {
+        let dets: Vec<Detection> = (0..n)
+            .map(|i| Detection::new(Point2::new(10.0 * i as f64 + f as f64, 5.0), 1.0))
+            .collect();
+        tracker
+            .step(
+                &FrameObservations::from_detections(f as u64, &dets),
+                &mut out,
+            )
+            .unwrap();
+    }
+    tracker.finish(&mut out).unwrap();
+    // Only frames with a point before and after can be the middle of a triplet.
+    assert!(out.iter().all(|p| p.frame == 4 || p.frame >= 9), "{out:?}");
+}
+
+#[test]
+fn bad_input_is_an_error_not_a_panic() {
+    let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
+    let mut out = Vec::new();
+    let det = [Detection::new(Point2::new(1.0, 1.0), 1.0)];
+    tracker
+        .step(&FrameObservations::from_detections(5, &det), &mut out)
+        .unwrap();
+    let err = tracker
+        .step(&FrameObservations::from_detections(3, &det), &mut out)
+        .unwrap_err();
+    assert!(err.to_string().contains("increasing"), "{err}");
+    let nan = [Detection::new(Point2::new(f64::NAN, 1.0), 1.0)];
+    let err = tracker
+        .step(&FrameObservations::from_detections(6, &nan), &mut out)
+        .unwrap_err();
+    assert!(err.to_string().contains("frame 6"), "{err}");
+}
+
+#[test]
+fn params_deserialise_with_defaults_and_errors_name_the_key() {
+    let params: PtvParams = serde_json::from_str(r#"{"motion_av": 5, "filter_std": 2.0}"#).unwrap();
+    assert_eq!(params.motion_av, 5);
+    assert_eq!(params.filter_time, PtvParams::default().filter_time);
+    assert!(serde_json::from_str::<PtvParams>(r#"{"motion_avg": 5}"#).is_err());
+    let bad = PtvParams {
+        filter_time: f64::INFINITY,
+        ..Default::default()
+    };
+    let err = PtvTracker::new(bad).unwrap_err().to_string();
+    assert!(err.contains("`filter_time`"), "{err}");
+}
+
+#[test]
+fn max_displacement_gate_rejects_long_links() {
+    let vel = Vec2::new(6.0, 0.0);
+    let scene = Scene::new(
+        7,
+        100,
+        8,
+        jittered_lattice(100.0),
+        |p, t| p + vel * t,
+        1.0,
+        0,
+    );
+    let gated = |gate| {
+        scene.track(PtvParams {
+            max_displacement_px: Some(gate),
+            ..Default::default()
+        })
+    };
+    assert!(gated(5.0).is_empty());
+    assert_eq!(gated(7.0).len(), 100 * 6);
+}
+
+#[test]
+fn backward_pass_keeps_forward_velocities() {
+    let vel = Vec2::new(1.5, -0.7);
+    let scene = Scene::new(
+        8,
+        100,
+        10,
+        jittered_lattice(50.0),
+        |p, t| p + vel * t,
+        1.0,
+        0,
+    );
+    let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
+    scene.feed(&mut tracker, PassDirection::Forward);
+    let backward = scene.feed(&mut tracker, PassDirection::Backward);
+    assert_eq!(backward.len(), 100 * 8);
+    assert!(backward.windows(2).all(|w| w[0].frame >= w[1].frame));
+    for p in backward {
+        assert!((p.vel_px_per_frame.unwrap() - vel).max_abs() < 1e-9);
+        assert!(p.acc_px_per_frame2.unwrap().max_abs() < 1e-9);
+    }
+}
+
+#[test]
+fn training_passes_track_at_least_as_much_as_one_pass() {
+    // Faster rotation (p⁻¹ up to ≈ 2.5 at the edge) over few frames: the model needs time.
+    let scene = rotating(9, 3000, (0.08, 0.0), 12, 1.0, 0);
+    let one_pass = scene.track(PtvParams::default());
+    let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
+    scene.feed(&mut tracker, PassDirection::Forward);
+    scene.feed(&mut tracker, PassDirection::Backward);
+    let trained = scene.feed(&mut tracker, PassDirection::Forward);
+    let (r1, p1) = scene.link_scores(&one_pass);
+    let (r3, p3) = scene.link_scores(&trained);
+    eprintln!(
+        "one pass: {} points, recall {r1:.3}, precision {p1:.4}; after training: {} points, recall {r3:.3}, precision {p3:.4}",
+        one_pass.len(),
+        trained.len()
+    );
+    assert!(trained.len() >= one_pass.len());
+    assert!(r3 >= r1);
+}

@@ -1,0 +1,244 @@
+//! One configuration for the whole pipeline: a TOML file, `--set key=value` overrides and
+//! TracTrac `*_par.txt` files all end up here, and are validated once before any work runs.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use sillage_core::{Error, Result};
+use sillage_detect::blob::BlobParams;
+use sillage_detect::preprocess::PreprocessParams;
+use sillage_track::ptv::PtvParams;
+
+/// Everything a run needs besides its input and output paths.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PipelineConfig {
+    /// Pre-processing of every frame before detection (median, background subtraction).
+    pub preprocess: PreprocessParams,
+    /// Mask image multiplied into every frame (TracTrac's `<name>_mask.tif`).
+    pub mask: Option<PathBuf>,
+    /// Which detector runs, with its parameters.
+    pub detector: DetectorConfig,
+    /// Which tracker runs, with its parameters.
+    pub tracker: TrackerConfig,
+    /// Extra passes over the sequence that only train the motion model before the output pass
+    /// (TracTrac's `vid_loop`; its CLI default is 2, ours 0 because each pass costs a full
+    /// tracking run). Detections are kept in memory while training passes are on.
+    pub training_passes: usize,
+}
+
+/// The built-in detectors; one variant each (`kind = "blob"` in TOML).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum DetectorConfig {
+    /// DoG/LoG blob detection with sub-pixel refinement (TracTrac §3.1.1).
+    Blob(BlobParams),
+}
+
+impl Default for DetectorConfig {
+    fn default() -> Self {
+        DetectorConfig::Blob(BlobParams::default())
+    }
+}
+
+/// The built-in trackers; one variant each (`kind = "ptv"` in TOML).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum TrackerConfig {
+    /// TracTrac-class three-frame PTV with a local-flow predictor (TracTrac §3.1.2-3.1.4).
+    Ptv(PtvParams),
+}
+
+impl Default for TrackerConfig {
+    fn default() -> Self {
+        TrackerConfig::Ptv(PtvParams::default())
+    }
+}
+
+/// Largest number of training passes accepted (each is a full tracking run).
+const MAX_TRAINING_PASSES: usize = 20;
+
+impl PipelineConfig {
+    /// Reads a TOML configuration file.
+    pub fn from_toml_file(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Self::from_toml_str(&text).map_err(|e| match e {
+            Error::Input(message) => Error::format(path, None, message),
+            other => other,
+        })
+    }
+
+    /// Parses a TOML configuration.
+    pub fn from_toml_str(text: &str) -> Result<Self> {
+        toml::from_str(text).map_err(|e| {
+            Error::input(format!(
+                "invalid configuration: {}; see `sillage config` for every key and its default",
+                e.message()
+            ))
+        })
+    }
+
+    /// The configuration as TOML text (what `sillage config` prints).
+    pub fn to_toml_string(&self) -> Result<String> {
+        toml::to_string_pretty(self)
+            .map_err(|e| Error::input(format!("cannot serialise the configuration: {e}")))
+    }
+
+    /// Applies one `key=value` override, `key` being a dotted path such as
+    /// `detector.scale_px` or `tracker.motion_av`; `value` is read as TOML (numbers, booleans,
+    /// strings with or without quotes).
+    pub fn set(&mut self, assignment: &str) -> Result<()> {
+        let (key, raw_value) = assignment.split_once('=').ok_or_else(|| {
+            Error::parameter(
+                assignment,
+                "",
+                "overrides look like `key=value`, e.g. `detector.scale_px=2.5`",
+            )
+        })?;
+        let key = key.trim();
+        let value = parse_toml_value(raw_value.trim());
+        let tree = toml::Value::try_from(&*self)
+            .map_err(|e| Error::input(format!("cannot serialise the configuration: {e}")))?;
+        // An enum is written as a one-key table (`threshold.auto.std_factor` vs
+        // `threshold.fixed`): when adding the key alone fails, choosing another variant is
+        // tried by emptying each enclosing section in turn, innermost first.
+        let depth = key.split('.').count();
+        let attempts = std::iter::once(None).chain((1..depth).rev().map(Some));
+        let mut first_error = None;
+        for clear_at in attempts {
+            let mut candidate = tree.clone();
+            insert_dotted(&mut candidate, key, value.clone(), clear_at)
+                .map_err(|message| Error::parameter(key, raw_value, message))?;
+            match candidate.try_into() {
+                Ok(config) => {
+                    *self = config;
+                    return Ok(());
+                }
+                Err(e) => {
+                    let e: toml::de::Error = e;
+                    first_error.get_or_insert(e);
+                }
+            }
+        }
+        let message = first_error
+            .map(|e| e.message().to_string())
+            .unwrap_or_default();
+        Err(Error::parameter(
+            key,
+            raw_value,
+            format!("{message}; see `sillage config` for every key"),
+        ))
+    }
+
+    /// Checks every parameter once; the error names the key and its allowed range.
+    pub fn validate(&self) -> Result<()> {
+        self.preprocess.validate()?;
+        match &self.detector {
+            DetectorConfig::Blob(params) => params.validate()?,
+        }
+        match &self.tracker {
+            TrackerConfig::Ptv(params) => params.validate()?,
+        }
+        if self.training_passes > MAX_TRAINING_PASSES {
+            return Err(Error::parameter(
+                "training_passes",
+                self.training_passes,
+                format!("must be in 0..={MAX_TRAINING_PASSES}"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Reads `raw` as a TOML value; bare words that are not TOML become strings.
+fn parse_toml_value(raw: &str) -> toml::Value {
+    toml::from_str::<toml::Table>(&format!("v = {raw}"))
+        .ok()
+        .and_then(|mut table| table.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(raw.to_string()))
+}
+
+/// Sets `tree[a][b]...[last] = value` for the dotted `key`, creating tables on the way; the
+/// table at depth `clear_at` (the one holding the `clear_at`-th segment) is emptied first.
+fn insert_dotted(
+    tree: &mut toml::Value,
+    key: &str,
+    value: toml::Value,
+    clear_at: Option<usize>,
+) -> std::result::Result<(), String> {
+    let mut node = tree;
+    let parts: Vec<&str> = key.split('.').collect();
+    for (depth, part) in parts.iter().enumerate() {
+        if part.is_empty() {
+            return Err("empty key segment; write keys like `tracker.motion_av`".into());
+        }
+        let table = node
+            .as_table_mut()
+            .ok_or_else(|| format!("`{}` is a value, not a section", parts[..depth].join(".")))?;
+        if clear_at == Some(depth) {
+            table.clear();
+        }
+        if depth + 1 == parts.len() {
+            table.insert((*part).to_string(), value);
+            return Ok(());
+        }
+        node = table
+            .entry((*part).to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sillage_detect::Threshold;
+
+    fn blob(config: &PipelineConfig) -> &BlobParams {
+        let DetectorConfig::Blob(params) = &config.detector;
+        params
+    }
+
+    #[test]
+    fn overrides_reach_nested_keys_and_enum_variants() {
+        let mut config = PipelineConfig::default();
+        config.set("detector.scale_px=3.5").unwrap();
+        config.set("tracker.motion_av = 4").unwrap();
+        config.set("detector.threshold.fixed=0.015").unwrap();
+        config.set("detector.subpixel=quadratic").unwrap();
+        assert_eq!(blob(&config).scale_px, 3.5);
+        assert_eq!(blob(&config).threshold, Threshold::Fixed(0.015));
+        let TrackerConfig::Ptv(ptv) = &config.tracker;
+        assert_eq!(ptv.motion_av, 4);
+        config.set("detector.threshold.auto.std_factor=2").unwrap();
+        assert_eq!(blob(&config).threshold, Threshold::Auto { std_factor: 2.0 });
+    }
+
+    #[test]
+    fn bad_overrides_name_the_key() {
+        let mut config = PipelineConfig::default();
+        let err = config.set("detector.scale_pix=3").unwrap_err().to_string();
+        assert!(err.contains("detector.scale_pix"), "{err}");
+        let err = config
+            .set("tracker.motion_av=many")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("tracker.motion_av"), "{err}");
+        assert!(config.set("no_equals_sign").is_err());
+        config.set("tracker.motion_av=0").unwrap();
+        let err = config.validate().unwrap_err().to_string();
+        assert!(err.contains("motion_av"), "{err}");
+    }
+
+    #[test]
+    fn toml_round_trips_and_rejects_unknown_keys() {
+        let mut config = PipelineConfig::default();
+        config.set("training_passes=2").unwrap();
+        let text = config.to_toml_string().unwrap();
+        assert_eq!(PipelineConfig::from_toml_str(&text).unwrap(), config);
+        let err = PipelineConfig::from_toml_str("[tracker]\nkind = \"ptv\"\nmotion_avg = 3\n")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("motion_avg"), "{err}");
+    }
+}

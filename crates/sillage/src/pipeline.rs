@@ -1,0 +1,320 @@
+//! The composition root: frames → pre-processing → detector → tracker → sink.
+
+use std::time::{Duration, Instant};
+
+use sillage_core::{
+    Detection, Detector, Error, FrameIndex, FrameObservations, GrayImage, Result, TrackPoint,
+    TrackSink, Tracker,
+};
+use sillage_detect::blob::BlobDetector;
+use sillage_detect::preprocess::Preprocessor;
+use sillage_io::Frame;
+use sillage_track::ptv::{PassDirection, PtvTracker};
+
+use crate::config::{DetectorConfig, PipelineConfig, TrackerConfig};
+
+/// The built-in detectors, chosen by [`DetectorConfig`].
+enum AnyDetector {
+    Blob(BlobDetector),
+}
+
+impl AnyDetector {
+    fn detect(&mut self, image: &GrayImage, out: &mut Vec<Detection>) -> Result<()> {
+        match self {
+            AnyDetector::Blob(d) => d.detect(image, out),
+        }
+    }
+}
+
+/// The built-in trackers, chosen by [`TrackerConfig`].
+enum AnyTracker {
+    Ptv(PtvTracker),
+}
+
+impl AnyTracker {
+    fn as_tracker(&mut self) -> &mut dyn Tracker {
+        match self {
+            AnyTracker::Ptv(t) => t,
+        }
+    }
+
+    fn start_pass(&mut self, direction: PassDirection) {
+        match self {
+            AnyTracker::Ptv(t) => t.start_pass(direction),
+        }
+    }
+}
+
+/// What one frame cost and produced.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FrameReport {
+    /// The frame's index.
+    pub frame: FrameIndex,
+    /// Objects detected in it.
+    pub detections: usize,
+    /// Track points emitted while processing it (points of earlier frames that became final).
+    pub points_emitted: usize,
+    /// Wall time of pre-processing and detection.
+    pub detect_time: Duration,
+    /// Wall time of the tracker's step.
+    pub track_time: Duration,
+}
+
+/// Totals of a whole run.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct RunSummary {
+    /// Frames processed in the output pass.
+    pub frames: u64,
+    /// Detections over all frames.
+    pub detections: u64,
+    /// Track points written.
+    pub points: u64,
+    /// Distinct trajectories among them.
+    pub tracks: u64,
+    /// Mean wall time of pre-processing + detection per frame, ms.
+    pub detect_ms_per_frame: f64,
+    /// Mean wall time of tracking per frame, ms.
+    pub track_ms_per_frame: f64,
+}
+
+/// A configured detector and tracker, fed one frame at a time.
+pub struct Pipeline {
+    preprocessor: Preprocessor,
+    mask: Option<GrayImage>,
+    detector: AnyDetector,
+    tracker: AnyTracker,
+    training_passes: usize,
+    preprocessed: GrayImage,
+    detections: Vec<Detection>,
+}
+
+/// Counts what passes through to the real sink, so the run summary needs no second look.
+struct CountingSink<'a> {
+    inner: &'a mut dyn TrackSink,
+    points: u64,
+    max_track_id: Option<u64>,
+    track_ids_seen: u64,
+}
+
+impl TrackSink for CountingSink<'_> {
+    fn accept(&mut self, points: &[TrackPoint]) -> Result<()> {
+        for p in points {
+            // Track ids are handed out in increasing order, so a new maximum is a new track.
+            if self.max_track_id.is_none_or(|m| p.track_id > m) {
+                self.max_track_id = Some(p.track_id);
+                self.track_ids_seen += 1;
+            }
+        }
+        self.points += points.len() as u64;
+        self.inner.accept(points)
+    }
+}
+
+/// A sink that drops everything (training passes).
+struct DiscardSink;
+
+impl TrackSink for DiscardSink {
+    fn accept(&mut self, _points: &[TrackPoint]) -> Result<()> {
+        Ok(())
+    }
+}
+
+impl Pipeline {
+    /// Builds the pipeline of `config` (validated here; the mask image is read here).
+    pub fn from_config(config: &PipelineConfig) -> Result<Self> {
+        config.validate()?;
+        let mask = config
+            .mask
+            .as_deref()
+            .map(sillage_io::read_image)
+            .transpose()?;
+        let detector = match &config.detector {
+            DetectorConfig::Blob(params) => AnyDetector::Blob(BlobDetector::new(*params)?),
+        };
+        let tracker = match &config.tracker {
+            TrackerConfig::Ptv(params) => AnyTracker::Ptv(PtvTracker::new(params.clone())?),
+        };
+        Ok(Self {
+            preprocessor: Preprocessor::new(config.preprocess)?,
+            mask,
+            detector,
+            tracker,
+            training_passes: config.training_passes,
+            preprocessed: GrayImage::default(),
+            detections: Vec::new(),
+        })
+    }
+
+    /// How many leading frames [`Pipeline::prime_background`] wants (0 without background
+    /// subtraction).
+    pub fn background_init_frames(&self) -> usize {
+        self.preprocessor
+            .params()
+            .background
+            .map_or(0, |background| background.init_frames)
+    }
+
+    /// Initialises the background model from the mean of the first frames, as TracTrac does
+    /// (Eq. (2)), before [`Pipeline::run`]. Pass the sequence's leading frames (a second
+    /// opening of the source); at most [`Pipeline::background_init_frames`] are read, one at a
+    /// time. Returns how many were used. Without priming, the background starts as the running
+    /// mean of the frames seen so far.
+    pub fn prime_background(
+        &mut self,
+        frames: impl Iterator<Item = Result<Frame>>,
+    ) -> Result<usize> {
+        let mut used = 0;
+        for frame in frames.take(self.background_init_frames()) {
+            let frame = frame?;
+            used += self.preprocessor.prime(std::iter::once(&frame.image))?;
+        }
+        Ok(used)
+    }
+
+    /// Pre-processes and detects one frame; the detections stay in `self.detections`.
+    fn detect(&mut self, frame: &Frame) -> Result<Duration> {
+        let start = Instant::now();
+        if let Some(mask) = &self.mask
+            && mask.dimensions() != frame.image.dimensions()
+        {
+            return Err(Error::frame(
+                &frame.path,
+                frame.index,
+                format!(
+                    "the mask is {}×{} but the frame is {}×{}; use a mask of the frame's size",
+                    mask.width(),
+                    mask.height(),
+                    frame.image.width(),
+                    frame.image.height()
+                ),
+            ));
+        }
+        self.preprocessor
+            .process(&frame.image, self.mask.as_ref(), &mut self.preprocessed)?;
+        self.detector
+            .detect(&self.preprocessed, &mut self.detections)?;
+        Ok(start.elapsed())
+    }
+
+    /// Runs the whole sequence: training passes first if configured, then the output pass that
+    /// feeds `sink`. `on_frame` is called after every frame of the output pass (progress bars).
+    pub fn run(
+        &mut self,
+        frames: impl Iterator<Item = Result<Frame>>,
+        sink: &mut dyn TrackSink,
+        on_frame: &mut dyn FnMut(&FrameReport),
+    ) -> Result<RunSummary> {
+        let mut counting = CountingSink {
+            inner: sink,
+            points: 0,
+            max_track_id: None,
+            track_ids_seen: 0,
+        };
+        let mut totals = RunSummary::default();
+        let (mut detect_time, mut track_time) = (Duration::ZERO, Duration::ZERO);
+        if self.training_passes == 0 {
+            for frame in frames {
+                let frame = frame?;
+                let detect = self.detect(&frame)?;
+                let report = self.track(frame.index, detect, &mut counting)?;
+                detect_time += report.detect_time;
+                track_time += report.track_time;
+                totals.frames += 1;
+                totals.detections += report.detections as u64;
+                on_frame(&report);
+            }
+        } else {
+            let cached = self.detect_all(frames)?;
+            self.train(&cached)?;
+            self.tracker.start_pass(PassDirection::Forward);
+            for (index, detections, detect) in &cached {
+                self.detections.clone_from(detections);
+                let report = self.track(*index, *detect, &mut counting)?;
+                detect_time += report.detect_time;
+                track_time += report.track_time;
+                totals.frames += 1;
+                totals.detections += report.detections as u64;
+                on_frame(&report);
+            }
+        }
+        self.tracker.as_tracker().finish(&mut counting)?;
+        totals.points = counting.points;
+        totals.tracks = counting.track_ids_seen;
+        if totals.frames > 0 {
+            totals.detect_ms_per_frame = detect_time.as_secs_f64() * 1e3 / totals.frames as f64;
+            totals.track_ms_per_frame = track_time.as_secs_f64() * 1e3 / totals.frames as f64;
+        }
+        Ok(totals)
+    }
+
+    /// Feeds `self.detections` of frame `index` to the tracker.
+    fn track(
+        &mut self,
+        index: FrameIndex,
+        detect_time: Duration,
+        sink: &mut CountingSink<'_>,
+    ) -> Result<FrameReport> {
+        let before = sink.points;
+        let start = Instant::now();
+        let observations = FrameObservations {
+            frame: index,
+            detections: &self.detections,
+            image: Some(&self.preprocessed),
+            confidence: None,
+        };
+        self.tracker.as_tracker().step(&observations, sink)?;
+        Ok(FrameReport {
+            frame: index,
+            detections: self.detections.len(),
+            points_emitted: (sink.points - before) as usize,
+            detect_time,
+            track_time: start.elapsed(),
+        })
+    }
+
+    /// First (forward) pass of a trained run: detects every frame, keeps the detections and
+    /// trains the tracker on them.
+    fn detect_all(
+        &mut self,
+        frames: impl Iterator<Item = Result<Frame>>,
+    ) -> Result<Vec<(FrameIndex, Vec<Detection>, Duration)>> {
+        let mut cached = Vec::new();
+        self.tracker.start_pass(PassDirection::Forward);
+        for frame in frames {
+            let frame = frame?;
+            let detect = self.detect(&frame)?;
+            let observations = FrameObservations::from_detections(frame.index, &self.detections);
+            self.tracker
+                .as_tracker()
+                .step(&observations, &mut DiscardSink)?;
+            cached.push((frame.index, self.detections.clone(), detect));
+        }
+        Ok(cached)
+    }
+
+    /// The extra training passes of TracTrac's `vid_loop`: alternately backward and forward
+    /// over the cached detections, the motion model carried from pass to pass.
+    fn train(&mut self, cached: &[(FrameIndex, Vec<Detection>, Duration)]) -> Result<()> {
+        for pass in 1..self.training_passes {
+            let backward = pass % 2 == 1;
+            let direction = if backward {
+                PassDirection::Backward
+            } else {
+                PassDirection::Forward
+            };
+            self.tracker.start_pass(direction);
+            let mut feed = |(index, detections, _): &(FrameIndex, Vec<Detection>, Duration)| {
+                let observations = FrameObservations::from_detections(*index, detections);
+                self.tracker
+                    .as_tracker()
+                    .step(&observations, &mut DiscardSink)
+            };
+            if backward {
+                cached.iter().rev().try_for_each(&mut feed)?;
+            } else {
+                cached.iter().try_for_each(&mut feed)?;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,41 @@
+//! Shared helpers of the facade's integration tests: a synthetic vortex run scored against
+//! its truth.
+
+use std::path::PathBuf;
+
+use sillage::core::{TrackPoint, TruthPoint};
+use sillage::eval::ptv::{PtvAccuracy, PtvAccuracyParams, ptv_accuracy};
+use sillage::io::Frame;
+use sillage::synth::vortex::{VortexParams, VortexSequence};
+use sillage::{Pipeline, PipelineConfig, RunSummary};
+
+/// Tracks the vortex sequence of `params` with `config` (frames streamed from the generator)
+/// and returns the emitted points with the truth.
+pub fn track_vortex(
+    params: &VortexParams,
+    config: &PipelineConfig,
+) -> (Vec<TrackPoint>, Vec<TruthPoint>, RunSummary) {
+    let mut truth = Vec::new();
+    let frames = VortexSequence::new(params.clone())
+        .expect("valid vortex parameters")
+        .map(|f| {
+            truth.extend_from_slice(&f.truth);
+            Ok(Frame {
+                index: f.index,
+                path: PathBuf::from(format!("vortex:{}", f.index)),
+                image: f.image,
+            })
+        });
+    let mut tracks = Vec::new();
+    let summary = Pipeline::from_config(config)
+        .expect("valid configuration")
+        .run(frames, &mut tracks, &mut |_| {})
+        .expect("tracking succeeds");
+    (tracks, truth, summary)
+}
+
+/// The TracTrac paper's accuracy indexes of a vortex run (d = 1 px).
+pub fn vortex_accuracy(params: &VortexParams, config: &PipelineConfig) -> PtvAccuracy {
+    let (tracks, truth, _) = track_vortex(params, config);
+    ptv_accuracy(&truth, &tracks, &PtvAccuracyParams::default()).expect("finite inputs")
+}
