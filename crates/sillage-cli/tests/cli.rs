@@ -75,7 +75,7 @@ fn synth_track_and_eval_round_trip() {
         "--frames",
         "8",
         "--particles",
-        "300",
+        "100",
         "--width",
         "256",
         "--height",
