@@ -65,7 +65,7 @@ impl PeakFinder {
             .for_each(|(band, peaks)| {
                 let y0 = n + band * BAND_ROWS;
                 let y1 = (y0 + BAND_ROWS).min(height - n);
-                scan_band(image, y0..y1, n, threshold, peaks);
+                scan_band_dispatch(image, y0..y1, n, threshold, peaks);
             });
         for band in &self.bands[..bands] {
             out.extend_from_slice(band);
@@ -76,7 +76,40 @@ impl PeakFinder {
 /// Pixels compared at once when looking for candidates (one bit each in a `u32` mask).
 const CANDIDATE_LANES: usize = 32;
 
+/// [`scan_band`] compiled for AVX2 when the CPU has it (wider compares for the candidate
+/// masks; compares are exact, so the peaks are the same on every path).
+fn scan_band_dispatch(
+    image: &GrayImage,
+    ys: std::ops::Range<usize>,
+    n: usize,
+    threshold: f32,
+    peaks: &mut Vec<Peak>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            unsafe { scan_band_avx2(image, ys, n, threshold, peaks) };
+            return;
+        }
+    }
+    scan_band(image, ys, n, threshold, peaks);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn scan_band_avx2(
+    image: &GrayImage,
+    ys: std::ops::Range<usize>,
+    n: usize,
+    threshold: f32,
+    peaks: &mut Vec<Peak>,
+) {
+    scan_band(image, ys, n, threshold, peaks);
+}
+
 /// Finds the peaks of rows `ys` into `peaks` (cleared first; see [`PeakFinder::find`]).
+#[inline(always)]
 fn scan_band(
     image: &GrayImage,
     ys: std::ops::Range<usize>,
@@ -136,7 +169,24 @@ fn candidate_mask(row: &[f32], x: usize, threshold: f32) -> u32 {
 
 /// True when every pixel before `(x, y)` in its window is `< v` and every pixel after it is
 /// `<= v` (so a NaN in the window rules the peak out).
+#[inline(always)]
 fn is_first_window_max(image: &GrayImage, x: usize, y: usize, n: usize, v: f32) -> bool {
+    if n == 1 {
+        // The 3×3 window (the default), branch-free: the same compares, no early exit.
+        let (up, row, down) = (
+            &image.row(y - 1)[x - 1..=x + 1],
+            &image.row(y)[x - 1..=x + 1],
+            &image.row(y + 1)[x - 1..=x + 1],
+        );
+        return (up[0] < v)
+            & (up[1] < v)
+            & (up[2] < v)
+            & (row[0] < v)
+            & (row[2] <= v)
+            & (down[0] <= v)
+            & (down[1] <= v)
+            & (down[2] <= v);
+    }
     for yy in y - n..=y + n {
         let r = &image.row(yy)[x - n..=x + n];
         let ok = match yy.cmp(&y) {

@@ -14,8 +14,9 @@
 //!
 //! Fast methods: the kernels are symmetric, so taps are folded by pairs, `w_j·(x[i−j] +
 //! x[i+j])`, halving the multiplies; the SIMD paths keep 8 vectors of outputs in registers
-//! across all taps; a difference of Gaussians subtracts the second vertical pass in registers,
-//! writing `G₁ − G₂` once.
+//! across all taps; a difference of Gaussians blurs each row segment with both kernels in one
+//! sweep (each tap pair loaded and summed once for both), and runs both vertical passes with
+//! both accumulator sets in registers, writing `G₁ − G₂` once.
 //!
 //! Every output value is computed by the same sequence of f32 operations whatever the band,
 //! the strip or the thread (no reduction across pixels, no fused multiply-add on any path), so
@@ -191,9 +192,17 @@ fn band<F: Fir>(
                 &pad[..sw + 2 * r]
             };
             let horizontal = |k: usize| (&input[r - k..], &input[r + k..]);
-            F::fir::<false>(&mut ring_a[slot * sw..(slot + 1) * sw], ka, horizontal);
-            if let Some(kb) = kb {
-                F::fir::<false>(&mut ring_b[slot * sw..(slot + 1) * sw], kb, horizontal);
+            let out_a = &mut ring_a[slot * sw..(slot + 1) * sw];
+            match kb {
+                // Both blurs from the same loads: each tap-pair sum `a + b` is formed once.
+                Some(kb) => F::fir_pair(
+                    out_a,
+                    &mut ring_b[slot * sw..(slot + 1) * sw],
+                    ka,
+                    kb,
+                    horizontal,
+                ),
+                None => F::fir::<false>(out_a, ka, horizontal),
             }
             slot = if slot + 1 == slots { 0 } else { slot + 1 };
             if i < 2 * r {
@@ -204,9 +213,16 @@ fn band<F: Fir>(
             let y = i - 2 * r;
             let centre = (i - r) % slots;
             let out_row = &mut out[y * width + x0..y * width + x0 + sw];
-            F::fir::<false>(out_row, ka, ring_taps(ring_a, sw, centre, slots));
-            if let Some(kb) = kb {
-                F::fir::<true>(out_row, kb, ring_taps(ring_b, sw, centre, slots));
+            let taps_a = ring_taps(ring_a, sw, centre, slots);
+            match kb {
+                Some(kb) => F::fir_diff(
+                    out_row,
+                    ka,
+                    taps_a,
+                    kb,
+                    ring_taps(ring_b, sw, centre, slots),
+                ),
+                None => F::fir::<false>(out_row, ka, taps_a),
             }
         }
         x0 += sw;
@@ -268,6 +284,26 @@ trait Fir {
         kernel: &[f32],
         taps: impl Fn(usize) -> (&'a [f32], &'a [f32]),
     );
+
+    /// `fir::<false>(out_a, ka, taps)` and `fir::<false>(out_b, kb, taps)` (same values, bit
+    /// for bit), sharing the loads and the tap-pair sums of the two kernels.
+    fn fir_pair<'a>(
+        out_a: &mut [f32],
+        out_b: &mut [f32],
+        ka: &[f32],
+        kb: &[f32],
+        taps: impl Fn(usize) -> (&'a [f32], &'a [f32]),
+    );
+
+    /// `fir::<false>(out, ka, taps_a)` then `fir::<true>(out, kb, taps_b)` (same values, bit
+    /// for bit), without storing and reloading the first result.
+    fn fir_diff<'a, 'b>(
+        out: &mut [f32],
+        ka: &[f32],
+        taps_a: impl Fn(usize) -> (&'a [f32], &'a [f32]),
+        kb: &[f32],
+        taps_b: impl Fn(usize) -> (&'b [f32], &'b [f32]),
+    );
 }
 
 /// Plain Rust: chunks of [`Portable::CHUNK`] outputs accumulate in a stack buffer, one sweep
@@ -313,6 +349,30 @@ impl Fir for Portable {
             x += m;
         }
     }
+
+    #[inline(always)]
+    fn fir_pair<'a>(
+        out_a: &mut [f32],
+        out_b: &mut [f32],
+        ka: &[f32],
+        kb: &[f32],
+        taps: impl Fn(usize) -> (&'a [f32], &'a [f32]),
+    ) {
+        Self::fir::<false>(out_a, ka, &taps);
+        Self::fir::<false>(out_b, kb, &taps);
+    }
+
+    #[inline(always)]
+    fn fir_diff<'a, 'b>(
+        out: &mut [f32],
+        ka: &[f32],
+        taps_a: impl Fn(usize) -> (&'a [f32], &'a [f32]),
+        kb: &[f32],
+        taps_b: impl Fn(usize) -> (&'b [f32], &'b [f32]),
+    ) {
+        Self::fir::<false>(out, ka, taps_a);
+        Self::fir::<true>(out, kb, taps_b);
+    }
 }
 
 /// Register-blocked SIMD FIRs for x86-64, generated from one template per instruction set.
@@ -326,8 +386,8 @@ mod simd {
     use super::{Fir, Portable};
 
     macro_rules! simd_fir {
-        ($name:ident, $vector:ty, $lanes:literal, $set1:ident, $load:ident, $store:ident,
-         $add:ident, $sub:ident, $mul:ident) => {
+        ($name:ident, $vector:ty, $lanes:literal, $pair:literal, $set1:ident, $load:ident,
+         $store:ident, $add:ident, $sub:ident, $mul:ident) => {
             /// Blocks of 8 vectors accumulate in registers across all taps (enough independent
             /// chains to hide the add latency): each tap costs two loads per vector, no store.
             pub(super) struct $name;
@@ -381,6 +441,138 @@ mod simd {
                         (&lo[blocks..], &hi[blocks..])
                     });
                 }
+
+                /// Blocks of `$pair` vectors per kernel: both accumulator sets stay in
+                /// registers, and each tap pair is loaded and summed once for both kernels.
+                #[inline(always)]
+                fn fir_pair<'a>(
+                    out_a: &mut [f32],
+                    out_b: &mut [f32],
+                    ka: &[f32],
+                    kb: &[f32],
+                    taps: impl Fn(usize) -> (&'a [f32], &'a [f32]),
+                ) {
+                    const BLOCK: usize = $pair * $lanes;
+                    let n = out_a.len();
+                    assert_eq!(out_b.len(), n);
+                    let blocks = n / BLOCK * BLOCK;
+                    let centre = &taps(0).0[..n];
+                    let taps_len = ka.len().max(kb.len());
+                    // SAFETY: as in `fir`: the instruction set is available, and every
+                    // load/store stays below `blocks <= n`, all slices holding `n` values.
+                    unsafe {
+                        let (wa0, wb0) = ($set1(ka[0]), $set1(kb[0]));
+                        let mut x = 0;
+                        while x < blocks {
+                            let mut acc_a: [$vector; $pair] = [wa0; $pair];
+                            let mut acc_b: [$vector; $pair] = [wb0; $pair];
+                            for v in 0..$pair {
+                                let c = $load(centre.as_ptr().add(x + $lanes * v));
+                                acc_a[v] = $mul(wa0, c);
+                                acc_b[v] = $mul(wb0, c);
+                            }
+                            for j in 1..taps_len {
+                                let (lo, hi) = taps(j);
+                                let (lo, hi) = (&lo[..n], &hi[..n]);
+                                let mut sum: [$vector; $pair] = [wa0; $pair];
+                                for (v, sum) in sum.iter_mut().enumerate() {
+                                    let a = $load(lo.as_ptr().add(x + $lanes * v));
+                                    let b = $load(hi.as_ptr().add(x + $lanes * v));
+                                    *sum = $add(a, b);
+                                }
+                                if let Some(&w) = ka.get(j) {
+                                    let w = $set1(w);
+                                    for (acc, &s) in acc_a.iter_mut().zip(&sum) {
+                                        *acc = $add(*acc, $mul(w, s));
+                                    }
+                                }
+                                if let Some(&w) = kb.get(j) {
+                                    let w = $set1(w);
+                                    for (acc, &s) in acc_b.iter_mut().zip(&sum) {
+                                        *acc = $add(*acc, $mul(w, s));
+                                    }
+                                }
+                            }
+                            for v in 0..$pair {
+                                $store(out_a.as_mut_ptr().add(x + $lanes * v), acc_a[v]);
+                                $store(out_b.as_mut_ptr().add(x + $lanes * v), acc_b[v]);
+                            }
+                            x += BLOCK;
+                        }
+                    }
+                    let tail = |j| {
+                        let (lo, hi) = taps(j);
+                        (&lo[blocks..], &hi[blocks..])
+                    };
+                    Portable::fir::<false>(&mut out_a[blocks..], ka, tail);
+                    Portable::fir::<false>(&mut out_b[blocks..], kb, tail);
+                }
+
+                /// Blocks of `$pair` vectors per kernel, both accumulator sets in registers;
+                /// the difference is stored once.
+                #[inline(always)]
+                fn fir_diff<'a, 'b>(
+                    out: &mut [f32],
+                    ka: &[f32],
+                    taps_a: impl Fn(usize) -> (&'a [f32], &'a [f32]),
+                    kb: &[f32],
+                    taps_b: impl Fn(usize) -> (&'b [f32], &'b [f32]),
+                ) {
+                    const BLOCK: usize = $pair * $lanes;
+                    let n = out.len();
+                    let blocks = n / BLOCK * BLOCK;
+                    let (centre_a, centre_b) = (&taps_a(0).0[..n], &taps_b(0).0[..n]);
+                    // SAFETY: as in `fir`: the instruction set is available, and every
+                    // load/store stays below `blocks <= n`, all slices holding `n` values.
+                    unsafe {
+                        let (wa0, wb0) = ($set1(ka[0]), $set1(kb[0]));
+                        let mut x = 0;
+                        while x < blocks {
+                            let mut acc_a: [$vector; $pair] = [wa0; $pair];
+                            let mut acc_b: [$vector; $pair] = [wb0; $pair];
+                            for v in 0..$pair {
+                                let o = x + $lanes * v;
+                                acc_a[v] = $mul(wa0, $load(centre_a.as_ptr().add(o)));
+                                acc_b[v] = $mul(wb0, $load(centre_b.as_ptr().add(o)));
+                            }
+                            for (j, &w) in ka.iter().enumerate().skip(1) {
+                                let (lo, hi) = taps_a(j);
+                                let (lo, hi) = (&lo[..n], &hi[..n]);
+                                let w = $set1(w);
+                                for (v, acc) in acc_a.iter_mut().enumerate() {
+                                    let a = $load(lo.as_ptr().add(x + $lanes * v));
+                                    let b = $load(hi.as_ptr().add(x + $lanes * v));
+                                    *acc = $add(*acc, $mul(w, $add(a, b)));
+                                }
+                            }
+                            for (j, &w) in kb.iter().enumerate().skip(1) {
+                                let (lo, hi) = taps_b(j);
+                                let (lo, hi) = (&lo[..n], &hi[..n]);
+                                let w = $set1(w);
+                                for (v, acc) in acc_b.iter_mut().enumerate() {
+                                    let a = $load(lo.as_ptr().add(x + $lanes * v));
+                                    let b = $load(hi.as_ptr().add(x + $lanes * v));
+                                    *acc = $add(*acc, $mul(w, $add(a, b)));
+                                }
+                            }
+                            for v in 0..$pair {
+                                $store(
+                                    out.as_mut_ptr().add(x + $lanes * v),
+                                    $sub(acc_a[v], acc_b[v]),
+                                );
+                            }
+                            x += BLOCK;
+                        }
+                    }
+                    Portable::fir::<false>(&mut out[blocks..], ka, |j| {
+                        let (lo, hi) = taps_a(j);
+                        (&lo[blocks..], &hi[blocks..])
+                    });
+                    Portable::fir::<true>(&mut out[blocks..], kb, |j| {
+                        let (lo, hi) = taps_b(j);
+                        (&lo[blocks..], &hi[blocks..])
+                    });
+                }
             }
         };
     }
@@ -389,6 +581,7 @@ mod simd {
         Avx2,
         __m256,
         8,
+        4,
         _mm256_set1_ps,
         _mm256_loadu_ps,
         _mm256_storeu_ps,
@@ -400,6 +593,7 @@ mod simd {
         Avx512,
         __m512,
         16,
+        8,
         _mm512_set1_ps,
         _mm512_loadu_ps,
         _mm512_storeu_ps,
