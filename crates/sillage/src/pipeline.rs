@@ -84,6 +84,8 @@ pub struct Pipeline {
     detector: AnyDetector,
     tracker: AnyTracker,
     training_passes: usize,
+    /// Whether any pre-processing (median, background, mask) runs before detection.
+    preprocessing: bool,
     preprocessed: GrayImage,
     detections: Vec<Detection>,
 }
@@ -140,6 +142,9 @@ impl Pipeline {
             detector,
             tracker,
             training_passes: config.training_passes,
+            preprocessing: config.preprocess.median.is_some()
+                || config.preprocess.background.is_some()
+                || config.mask.is_some(),
             preprocessed: GrayImage::default(),
             detections: Vec::new(),
         })
@@ -189,10 +194,15 @@ impl Pipeline {
                 ),
             ));
         }
-        self.preprocessor
-            .process(&frame.image, self.mask.as_ref(), &mut self.preprocessed)?;
-        self.detector
-            .detect(&self.preprocessed, &mut self.detections)?;
+        if self.preprocessing {
+            self.preprocessor
+                .process(&frame.image, self.mask.as_ref(), &mut self.preprocessed)?;
+            self.detector
+                .detect(&self.preprocessed, &mut self.detections)?;
+        } else {
+            // Nothing to do before detection: no copy of the frame.
+            self.detector.detect(&frame.image, &mut self.detections)?;
+        }
         Ok(start.elapsed())
     }
 
@@ -216,7 +226,7 @@ impl Pipeline {
             for frame in frames {
                 let frame = frame?;
                 let detect = self.detect(&frame)?;
-                let report = self.track(frame.index, detect, &mut counting)?;
+                let report = self.track(frame.index, Some(&frame), detect, &mut counting)?;
                 detect_time += report.detect_time;
                 track_time += report.track_time;
                 totals.frames += 1;
@@ -229,7 +239,7 @@ impl Pipeline {
             self.tracker.start_pass(PassDirection::Forward);
             for (index, detections, detect) in &cached {
                 self.detections.clone_from(detections);
-                let report = self.track(*index, *detect, &mut counting)?;
+                let report = self.track(*index, None, *detect, &mut counting)?;
                 detect_time += report.detect_time;
                 track_time += report.track_time;
                 totals.frames += 1;
@@ -247,19 +257,26 @@ impl Pipeline {
         Ok(totals)
     }
 
-    /// Feeds `self.detections` of frame `index` to the tracker.
+    /// Feeds `self.detections` of frame `index` to the tracker, with the image the detector saw
+    /// when `frame` is at hand (not in replayed training passes).
     fn track(
         &mut self,
         index: FrameIndex,
+        frame: Option<&Frame>,
         detect_time: Duration,
         sink: &mut CountingSink<'_>,
     ) -> Result<FrameReport> {
         let before = sink.points;
         let start = Instant::now();
+        let image = match frame {
+            Some(_) if self.preprocessing => Some(&self.preprocessed),
+            Some(frame) => Some(&frame.image),
+            None => None,
+        };
         let observations = FrameObservations {
             frame: index,
             detections: &self.detections,
-            image: Some(&self.preprocessed),
+            image,
             confidence: None,
         };
         self.tracker.as_tracker().step(&observations, sink)?;
