@@ -311,3 +311,40 @@ fn bad_command_lines_exit_with_2_and_bad_overrides_with_1() {
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("motion_av"), "{}", stderr(&out));
 }
+
+#[test]
+fn one_thread_and_the_default_write_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = dir.path().join("vortex");
+    let out = sillage(&[
+        "synth",
+        "vortex",
+        "--out",
+        path_str(&frames),
+        "--frames",
+        "6",
+        "--particles",
+        "400",
+        "--width",
+        "320",
+        "--height",
+        "320",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let run = |threads: Option<&str>, name: &str| {
+        let path = dir.path().join(name);
+        let mut command = Command::new(env!("CARGO_BIN_EXE_sillage"));
+        command.args(["ptv", path_str(&frames), "--out", path_str(&path)]);
+        match threads {
+            Some(n) => command.env("RAYON_NUM_THREADS", n),
+            None => command.env_remove("RAYON_NUM_THREADS"),
+        };
+        let out = command.output().unwrap();
+        assert!(out.status.success(), "{}", stderr(&out));
+        fs::read(path).unwrap()
+    };
+    let one = run(Some("1"), "one_track.txt");
+    assert!(one.len() > 1000);
+    assert_eq!(one, run(None, "default_track.txt"));
+    assert_eq!(run(Some("1"), "one.csv"), run(None, "default.csv"));
+}
