@@ -100,18 +100,12 @@ fn bench_case(size: usize, particles: usize, frames: usize) -> Result<BenchRow> 
 /// stays flat whatever the sequence length. Track points go to a sink that drops them (as a
 /// file writer would after writing).
 fn memory_stream(size: usize, particles: usize, frames: usize) -> Result<()> {
-    struct Discard;
-    impl sillage::core::TrackSink for Discard {
-        fn accept(&mut self, _: &[TrackPoint]) -> sillage::core::Result<()> {
-            Ok(())
-        }
-    }
     println!("memory over a {frames}-frame stream ({size}×{size}, {particles} particles):");
     let mut pipeline = Pipeline::from_config(&PipelineConfig::default())?;
     let step = (frames / 10).max(1);
     pipeline.run(
         vortex_frames(size, particles, frames)?,
-        &mut Discard,
+        &mut sillage::core::DiscardSink,
         &mut |report| {
             let done = report.frame as usize + 1;
             if done.is_multiple_of(step) {

@@ -63,27 +63,33 @@ fn write_tiff_frames(dir: &Path, n: usize, width: usize, height: usize) -> Vec<P
         .collect()
 }
 
+/// `sillage synth vortex` into `dir`: square frames of `side` px.
+fn synth_vortex(dir: &Path, frames: usize, particles: usize, side: usize, snr: u32) {
+    let args = [
+        "synth".to_string(),
+        "vortex".into(),
+        "--out".into(),
+        path_str(dir).into(),
+        "--frames".into(),
+        frames.to_string(),
+        "--particles".into(),
+        particles.to_string(),
+        "--width".into(),
+        side.to_string(),
+        "--height".into(),
+        side.to_string(),
+        "--snr".into(),
+        snr.to_string(),
+    ];
+    let out = sillage(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 #[test]
 fn synth_track_and_eval_round_trip() {
     let dir = tempfile::tempdir().unwrap();
     let frames = dir.path().join("vortex");
-    let out = sillage(&[
-        "synth",
-        "vortex",
-        "--out",
-        path_str(&frames),
-        "--frames",
-        "8",
-        "--particles",
-        "100",
-        "--width",
-        "256",
-        "--height",
-        "256",
-        "--snr",
-        "8",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    synth_vortex(&frames, 8, 100, 256, 8);
     let tracks = dir.path().join("vortex_track.txt");
     let out = sillage(&[
         "ptv",
@@ -316,21 +322,7 @@ fn bad_command_lines_exit_with_2_and_bad_overrides_with_1() {
 fn one_thread_and_the_default_write_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
     let frames = dir.path().join("vortex");
-    let out = sillage(&[
-        "synth",
-        "vortex",
-        "--out",
-        path_str(&frames),
-        "--frames",
-        "6",
-        "--particles",
-        "400",
-        "--width",
-        "320",
-        "--height",
-        "320",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    synth_vortex(&frames, 6, 400, 320, 4);
     let run = |threads: Option<&str>, name: &str| {
         let path = dir.path().join(name);
         let mut command = Command::new(env!("CARGO_BIN_EXE_sillage"));

@@ -34,4 +34,4 @@ pub use geometry::{Point2, Vec2};
 pub use image::{GrayImage, Image};
 pub use observation::{Detection, FrameIndex, MotionState, TrackId, TrackPoint, TruthPoint};
 pub use rng::{RngStream, rng_stream};
-pub use roles::{Detector, FrameObservations, TrackSink, Tracker};
+pub use roles::{Detector, DiscardSink, FrameObservations, TrackSink, Tracker};

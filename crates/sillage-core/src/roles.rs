@@ -61,3 +61,14 @@ impl TrackSink for Vec<TrackPoint> {
         Ok(())
     }
 }
+
+/// A sink that drops every point: training passes, and timing runs where only the cost of
+/// tracking matters.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DiscardSink;
+
+impl TrackSink for DiscardSink {
+    fn accept(&mut self, _points: &[TrackPoint]) -> Result<()> {
+        Ok(())
+    }
+}

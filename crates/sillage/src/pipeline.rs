@@ -3,8 +3,8 @@
 use std::time::{Duration, Instant};
 
 use sillage_core::{
-    Detection, Detector, Error, FrameIndex, FrameObservations, GrayImage, Result, TrackPoint,
-    TrackSink, Tracker,
+    Detection, Detector, DiscardSink, Error, FrameIndex, FrameObservations, GrayImage, Result,
+    TrackPoint, TrackSink, Tracker,
 };
 use sillage_detect::blob::BlobDetector;
 use sillage_detect::preprocess::Preprocessor;
@@ -109,15 +109,6 @@ impl TrackSink for CountingSink<'_> {
         }
         self.points += points.len() as u64;
         self.inner.accept(points)
-    }
-}
-
-/// A sink that drops everything (training passes).
-struct DiscardSink;
-
-impl TrackSink for DiscardSink {
-    fn accept(&mut self, _points: &[TrackPoint]) -> Result<()> {
-        Ok(())
     }
 }
 
