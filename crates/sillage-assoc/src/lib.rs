@@ -7,6 +7,9 @@
 //! - [`BruteForceIndex`]: the obviously-correct O(n) reference the grid is tested against.
 //! - [`mutual_nearest_neighbours`] / [`mutual_pairs`]: the unequivocal forward-backward
 //!   association of TracTrac (§3.1.2 of the TracTrac paper).
+//! - [`LapSolver`] / [`solve_assignment`]: optimal one-to-one assignment on a dense
+//!   rectangular cost matrix with forbidden pairs (Jonker–Volgenant shortest augmenting
+//!   paths), checked against exhaustive search.
 //!
 //! Ties are broken deterministically: among points at the same distance the lower index wins.
 //! Points with a non-finite coordinate are never returned, and a non-finite query finds nothing.
@@ -25,14 +28,20 @@
 //!
 //! let next = [Point2::new(11.0, 0.5), Point2::new(0.5, 0.5)];
 //! assert_eq!(mutual_nearest_neighbours(&frame, &next, None), vec![Some(1), Some(0), None]);
+//!
+//! // Row 1 may only take column 0: row 0 yields it, as two pairs beat one cheaper pair.
+//! let costs = [1.0, 2.0, 1.0, f64::INFINITY];
+//! assert_eq!(sillage_assoc::solve_assignment(2, 2, &costs), vec![Some(1), Some(0)]);
 //! ```
 
 mod brute;
 mod grid;
 mod index;
+pub mod lap;
 mod mutual;
 
 pub use brute::BruteForceIndex;
 pub use grid::PointIndex;
 pub use index::{Neighbour, NeighbourIndex};
+pub use lap::{LapSolver, solve_assignment};
 pub use mutual::{mutual_nearest_neighbours, mutual_pairs};

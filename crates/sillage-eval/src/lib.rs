@@ -1,6 +1,8 @@
-//! Metrics as pure functions of truth and estimate: PTV recovery indexes, detection
-//! recall/precision.
+//! Metrics as pure functions of truth and estimate: multi-object tracking metrics (CLEAR
+//! MOT, Identity, HOTA), PTV recovery indexes, detection recall/precision.
 //!
+//! - [`mot`]: CLEAR MOT, IDF1 and HOTA equal to TrackEval and py-motmetrics
+//!   ([`mot::evaluate_mot`]; see `docs/evaluation.md`).
 //! - [`ptv_accuracy`]: the four accuracy indexes of the TracTrac paper (§4.1.2, Fig. 4):
 //!   true and false recovery rates, mean position and displacement errors.
 //! - [`detection_scores`]: recall, precision and localisation error of a detector.
@@ -23,8 +25,10 @@
 
 pub mod detection;
 mod matching;
+pub mod mot;
 pub mod ptv;
 mod summary;
 
 pub use detection::{DetectionScores, detection_scores};
+pub use mot::{MotData, MotMetrics, MotParams, MotReport, evaluate_mot};
 pub use ptv::{PtvAccuracy, PtvAccuracyParams, ptv_accuracy};

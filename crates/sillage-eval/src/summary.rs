@@ -31,3 +31,75 @@ pub(crate) fn percent(rate: Option<f64>) -> String {
 pub(crate) fn px(value: Option<f64>) -> String {
     value.map_or_else(|| "n/a".to_owned(), |v| format!("{v:.3} px"))
 }
+
+/// A score in `[0, 1]` as a percentage with three decimals (TrackEval's tables).
+pub(crate) fn score(value: f64) -> String {
+    format!("{:.3}", 100.0 * value)
+}
+
+/// A count.
+pub(crate) fn count(value: u64) -> String {
+    value.to_string()
+}
+
+/// A plain-text table: a header row and value rows, columns right-aligned to their widest
+/// cell (the first column left-aligned).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Table {
+    rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// A table with the given column names.
+    pub fn new(header: impl IntoIterator<Item = String>) -> Self {
+        Self {
+            rows: vec![header.into_iter().collect()],
+        }
+    }
+
+    /// A header and one row from `(name, value)` columns.
+    pub fn single(columns: &[(&str, String)]) -> Self {
+        let mut table = Self::new(columns.iter().map(|(name, _)| (*name).to_owned()));
+        table.push(columns.iter().map(|(_, value)| value.clone()));
+        table
+    }
+
+    /// Appends a row.
+    pub fn push(&mut self, row: impl IntoIterator<Item = String>) {
+        self.rows.push(row.into_iter().collect());
+    }
+}
+
+impl std::fmt::Display for Table {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let columns = self.rows.iter().map(Vec::len).max().unwrap_or(0);
+        let widths: Vec<usize> = (0..columns)
+            .map(|c| {
+                self.rows
+                    .iter()
+                    .filter_map(|row| row.get(c))
+                    .map(|cell| cell.chars().count())
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        for row in &self.rows {
+            let mut line = String::new();
+            for (c, cell) in row.iter().enumerate() {
+                if c > 0 {
+                    line.push_str("  ");
+                }
+                let pad = " ".repeat(widths[c] - cell.chars().count());
+                if c == 0 && columns > 1 {
+                    line.push_str(cell);
+                    line.push_str(&pad);
+                } else {
+                    line.push_str(&pad);
+                    line.push_str(cell);
+                }
+            }
+            writeln!(f, "{}", line.trim_end())?;
+        }
+        Ok(())
+    }
+}

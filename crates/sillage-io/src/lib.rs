@@ -1,7 +1,7 @@
 //! Reading and writing everything that crosses the file system: frame sources (image
 //! folders, glob patterns, multi-page TIFF stacks, videos through the `ffmpeg` program),
 //! track tables (TracTrac `_track.txt`, CSV, Parquet, HDF5), ground truth and detections
-//! (CSV), and TracTrac parameter files.
+//! (CSV), MOTChallenge files, and TracTrac parameter files.
 //!
 //! Roles:
 //! - [`open_frames`] turns an INPUT string into a [`FrameSource`], an iterator of
@@ -10,7 +10,10 @@
 //!   streams points into a file; [`read_tracks`] reads one back;
 //! - [`TruthCsvWriter`] / [`read_truth_csv`], [`DetectionsCsvWriter`] /
 //!   [`read_detections_csv`] for ground truth and saved detections;
-//! - [`read_tractrac_par`] / [`write_tractrac_par`] for TracTrac's `*_par.txt`.
+//! - [`read_tractrac_par`] / [`write_tractrac_par`] for TracTrac's `*_par.txt`;
+//! - [`read_mot_sequence`] / [`read_mot_rows`] / [`read_seqinfo`] for MOTChallenge
+//!   `gt.txt`, `det.txt`, results and `seqinfo.ini` (a file or a sequence folder), and
+//!   [`MotResultsWriter`] / [`write_mot_results`] for results.
 //!
 //! Every file is written as `.NAME.partial` in the destination folder and renamed when
 //! complete. Errors name the file, the line or frame, and the fix.
@@ -50,6 +53,7 @@
 
 mod detections;
 mod frames;
+mod mot;
 mod partial;
 mod text_table;
 mod tracks;
@@ -60,6 +64,10 @@ pub use detections::{
     DETECTIONS_HEADER, DetectionsCsvWriter, read_detections_csv, write_detections_csv,
 };
 pub use frames::{Frame, FrameOptions, FrameSource, open_frames, read_image, write_png16};
+pub use mot::{
+    MotFileRole, MotResultsWriter, MotRow, MotSequenceFile, SeqInfo, parse_mot_rows, parse_seqinfo,
+    read_mot_rows, read_mot_sequence, read_seqinfo, write_mot_results,
+};
 pub use tracks::{
     TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackWriter,
     WrittenSummary, create_track_writer, read_tracks,
