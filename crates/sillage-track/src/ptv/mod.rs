@@ -2,7 +2,8 @@
 //!
 //! At each new frame t, [`PtvTracker`]:
 //! 1. predicts where the points of frame t−1 go, `x + U·dt`, with a motion model averaged
-//!    over the k nearest velocity samples (Eqs. 8–9; `U = 0` until two samples exist);
+//!    over the k nearest velocity samples (Eqs. 8–9; `U = 0` until two samples exist),
+//!    optionally corrected by displacement voting (`vote_search_px`, see `voting`);
 //! 2. keeps the mutual nearest-neighbour pairs between the predictions and frame t;
 //! 3. makes a tracklet of every point of frame t−1 paired both backwards (t−2 ↔ t−1) and
 //!    forwards (t−1 ↔ t), with central-difference kinematics (Eqs. 6–7);
@@ -17,6 +18,7 @@ mod filter;
 mod motion;
 mod params;
 mod tracker;
+mod voting;
 
 pub use params::PtvParams;
 pub use tracker::{PassDirection, PtvTracker};

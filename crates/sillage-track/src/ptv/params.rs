@@ -5,7 +5,8 @@ use sillage_core::{Error, Result};
 
 /// Parameters of [`crate::ptv::PtvTracker`]. Keys and defaults are those of TracTrac's
 /// parameter file as its command line fills them in (`set_default_parameter`), so a
-/// TracTrac `*_par.txt` maps one to one; `max_displacement_px` and `dt` are additions.
+/// TracTrac `*_par.txt` maps one to one; `vote_search_px`, `max_displacement_px` and `dt`
+/// are additions.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PtvParams {
@@ -23,6 +24,13 @@ pub struct PtvParams {
     /// Memory weight of the motion model and of the threshold (TracTrac's relaxation weight;
     /// the paper's α ≈ 1 / (1 + filter_time)); default 1.0.
     pub filter_time: f64,
+    /// Displacement voting for fast flows (p⁻¹ ≳ 0.5, see `voting`): at every frame, the
+    /// motion model's prediction is corrected by the local displacement that the pairs
+    /// within this many px of it vote for, and before the model has samples (the start of
+    /// the first pass) the prediction is voted from zero motion. Set it to the largest
+    /// expected error of a zero-motion guess, i.e. the largest displacement; default `None`
+    /// (TracTrac's behaviour: the prediction is the model alone, zero at the start).
+    pub vote_search_px: Option<f64>,
     /// Reject pairs whose displacement exceeds this many px (TracTrac has no such gate);
     /// default `None`.
     pub max_displacement_px: Option<f64>,
@@ -39,6 +47,7 @@ impl Default for PtvParams {
             filter: true,
             filter_std: 1.5,
             filter_time: 1.0,
+            vote_search_px: None,
             max_displacement_px: None,
             dt: 1.0,
         }
@@ -77,6 +86,16 @@ impl PtvParams {
                 "filter_time",
                 self.filter_time,
                 "must be a finite number ≥ 0 (typically 1)",
+            ));
+        }
+        if let Some(radius) = self.vote_search_px
+            && !(radius.is_finite() && radius > 0.0)
+        {
+            return Err(Error::parameter(
+                "vote_search_px",
+                radius,
+                "must be a finite number > 0 (the largest expected displacement, px), or \
+                 absent for no displacement voting",
             ));
         }
         if let Some(gate) = self.max_displacement_px
@@ -132,6 +151,13 @@ mod tests {
                 "filter_time",
                 PtvParams {
                     filter_time: -1.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "vote_search_px",
+                PtvParams {
+                    vote_search_px: Some(f64::INFINITY),
                     ..Default::default()
                 },
             ),

@@ -9,6 +9,7 @@ use sillage_core::{
 use super::filter::{INITIAL_THRESHOLD, log10_error, updated_threshold};
 use super::motion::{MotionField, Samples};
 use super::params::PtvParams;
+use super::voting::voted_displacements;
 
 /// Direction of a pass over the sequence (TracTrac's `vid_loop` alternates them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -85,6 +86,8 @@ pub struct PtvTracker {
     vel_pred: Vec<Vec2>,
     log_err_pred: Vec<f64>,
     pred: Vec<Point2>,
+    displacements: Vec<Vec2>,
+    voted: Vec<Vec2>,
     forward: Vec<Option<Neighbour>>,
     backward: Vec<Option<Neighbour>>,
     link12: Vec<Option<usize>>,
@@ -122,6 +125,8 @@ impl PtvTracker {
             vel_pred: Vec::new(),
             log_err_pred: Vec::new(),
             pred: Vec::new(),
+            displacements: Vec::new(),
+            voted: Vec::new(),
             forward: Vec::new(),
             backward: Vec::new(),
             link12: Vec::new(),
@@ -209,6 +214,9 @@ impl PtvTracker {
             self.log_err_pred.clear();
             self.log_err_pred.resize(self.c1.len(), 0.0);
         }
+        if let Some(search_px) = self.params.vote_search_px {
+            self.correct_by_voting(applied, search_px, dt);
+        }
         self.pred.clear();
         self.pred.extend(
             self.c1
@@ -217,6 +225,35 @@ impl PtvTracker {
                 .map(|(&p, &u)| p + u * dt),
         );
         applied
+    }
+
+    /// Displacement voting (`vote_search_px`): replaces the predicted velocities by the
+    /// displacement voted within `search_px` of them. Without a model (`model_applied`
+    /// false) the vote starts from zero motion and its result is also stored as the model,
+    /// so that the next frame is predicted from it.
+    fn correct_by_voting(&mut self, model_applied: bool, search_px: f64, dt: f64) {
+        self.displacements.clear();
+        self.displacements
+            .extend(self.vel_pred.iter().map(|&u| u * dt));
+        let mut voted = std::mem::take(&mut self.voted);
+        if let Some(resolution_px) = voted_displacements(
+            &self.c1,
+            &self.c2,
+            Some(&self.displacements),
+            search_px,
+            &mut voted,
+        ) {
+            for (u, &d) in self.vel_pred.iter_mut().zip(&voted) {
+                *u = d / dt;
+            }
+            if !model_applied {
+                self.stored.clear();
+                for (&p, &u) in self.c1.iter().zip(&self.vel_pred) {
+                    self.stored.push(p, u, resolution_px.log10());
+                }
+            }
+        }
+        self.voted = voted;
     }
 
     /// Mutual nearest neighbours between the predictions and frame t (Eq. 9 then §3.1.2),

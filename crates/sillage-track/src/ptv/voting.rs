@@ -1,0 +1,438 @@
+//! Displacement voting: the local displacement between two frames, estimated from the point
+//! sets alone, to start and to correct the motion model in fast flows.
+//!
+//! TracTrac's predictor is built from tracklets, and the first tracklets come from plain
+//! nearest neighbours, which are wrong as soon as displacements exceed the spacing between
+//! objects (p⁻¹ ≳ 0.5); the model then learns from wrong links, and a region where it has
+//! gone wrong never recovers, since wrong links agree with a wrong model. This module does
+//! what PIV's cross-correlation does, on point sets. In each cell of a grid, every point of
+//! frame `a` votes for its displacement to every point of frame `b` within a search radius
+//! of its prior (zero, or the model's prediction); the true displacement, shared by the
+//! cell's points, collects about one vote per point while the wrong pairs scatter over the
+//! histogram. The cell's residual is the median of the votes at the histogram's peak.
+//! Cells without a significant peak, and outliers of the normalised median test
+//! (Westerweel & Scarano 2005, Exp. Fluids 39:1096), take the median of their neighbours.
+//! A second pass on a grid twice as fine searches a small radius around the first estimate
+//! (PIV's multi-pass refinement). Each point's displacement is its prior plus the bilinear
+//! interpolation of the residual fields.
+
+use sillage_core::{Point2, Vec2};
+
+/// Points of frame `a` per cell of the first pass: enough votes for a clear peak.
+const POINTS_PER_CELL: f64 = 24.0;
+/// Histogram bins across the search radius in the first pass.
+const BINS_PER_RADIUS: f64 = 25.0;
+/// Smallest histogram bin, px (sub-pixel bins only split the peak).
+const MIN_BIN_PX: f64 = 0.5;
+/// Second pass: search radius in first-pass bins, and bin as a share of the first bin.
+const REFINE_RADIUS_BINS: f64 = 3.0;
+const REFINE_BIN_SHARE: f64 = 0.25;
+/// Normalised median test: residual threshold and noise floor in bins (Westerweel &
+/// Scarano's 2 and 0.1 px, the floor scaled to the bin).
+const MEDIAN_TEST_THRESHOLD: f64 = 2.0;
+const MEDIAN_TEST_FLOOR_BINS: f64 = 0.1;
+/// A peak is significant when it exceeds the count expected from random pairs by this
+/// many Poisson standard deviations, and holds at least [`MIN_PEAK_VOTES`].
+const PEAK_SIGMAS: f64 = 4.0;
+const MIN_PEAK_VOTES: f64 = 3.0;
+
+/// The displacement from frame `a` to frame `b` at each point of `a`, written to `out`
+/// (same order as `a`), and its resolution (the last histogram bin, px); `None` (and `out`
+/// left empty) when no cell found a significant displacement. `prior` (per point of `a`,
+/// zero when `None`) is the first guess and `search_px` the largest error of it searched.
+pub(crate) fn voted_displacements(
+    a: &[Point2],
+    b: &[Point2],
+    prior: Option<&[Vec2]>,
+    search_px: f64,
+    out: &mut Vec<Vec2>,
+) -> Option<f64> {
+    out.clear();
+    if a.is_empty() || b.is_empty() {
+        return None;
+    }
+    let extent = Extent::covering(a.iter().chain(b));
+    let cell = (extent.area() * POINTS_PER_CELL / a.len() as f64).sqrt();
+    let bin = (search_px / BINS_PER_RADIUS).max(MIN_BIN_PX);
+    let coarse_grid = Grid::new(&extent, cell);
+    let zero;
+    let prior = match prior {
+        Some(prior) => prior,
+        None => {
+            zero = vec![Vec2::ZERO; a.len()];
+            &zero
+        }
+    };
+    let coarse = vote_field(a, b, prior, &coarse_grid, search_px, bin)?;
+    let refined: Vec<Vec2> = a
+        .iter()
+        .zip(prior)
+        .map(|(&p, &d)| d + coarse_grid.interpolate(&coarse, p))
+        .collect();
+    let fine_grid = Grid::new(&extent, cell / 2.0);
+    let fine_bin = (bin * REFINE_BIN_SHARE).max(MIN_BIN_PX);
+    let fine_radius = bin * REFINE_RADIUS_BINS;
+    match vote_field(a, b, &refined, &fine_grid, fine_radius, fine_bin) {
+        Some(fine) => {
+            out.extend(
+                a.iter()
+                    .zip(&refined)
+                    .map(|(&p, &d)| d + fine_grid.interpolate(&fine, p)),
+            );
+            Some(fine_bin)
+        }
+        None => {
+            out.extend_from_slice(&refined);
+            Some(bin)
+        }
+    }
+}
+
+/// Bounding box of the points of both frames.
+struct Extent {
+    min: Point2,
+    max: Point2,
+}
+
+impl Extent {
+    fn covering<'a>(points: impl Iterator<Item = &'a Point2>) -> Self {
+        let mut min = Point2::new(f64::INFINITY, f64::INFINITY);
+        let mut max = Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for p in points {
+            min = Point2::new(min.x.min(p.x), min.y.min(p.y));
+            max = Point2::new(max.x.max(p.x), max.y.max(p.y));
+        }
+        Self { min, max }
+    }
+
+    /// Area in px², at least 1 (all points may share a row).
+    fn area(&self) -> f64 {
+        ((self.max.x - self.min.x).max(1.0)) * ((self.max.y - self.min.y).max(1.0))
+    }
+}
+
+/// A grid of square cells over an [`Extent`], with cells bucketing points.
+struct Grid {
+    origin: Point2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+}
+
+impl Grid {
+    fn new(extent: &Extent, cell: f64) -> Self {
+        let cell = cell.max(1.0);
+        let count = |span: f64| ((span / cell).floor() as usize + 1).max(1);
+        Self {
+            origin: extent.min,
+            cell,
+            nx: count(extent.max.x - extent.min.x),
+            ny: count(extent.max.y - extent.min.y),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// The (column, row) of the cell holding `p`, clamped to the grid.
+    fn cell_of(&self, p: Point2) -> (usize, usize) {
+        let clamp = |v: f64, n: usize| (v.max(0.0) as usize).min(n - 1);
+        (
+            clamp((p.x - self.origin.x) / self.cell, self.nx),
+            clamp((p.y - self.origin.y) / self.cell, self.ny),
+        )
+    }
+
+    /// Counting sort of `points` by cell: `(starts, order)` with the points of cell `c` at
+    /// `order[starts[c]..starts[c + 1]]`, in increasing index order.
+    fn bucket(&self, points: &[Point2]) -> (Vec<usize>, Vec<usize>) {
+        let mut starts = vec![0usize; self.len() + 1];
+        let cells: Vec<usize> = points
+            .iter()
+            .map(|&p| {
+                let (cx, cy) = self.cell_of(p);
+                cy * self.nx + cx
+            })
+            .collect();
+        for &c in &cells {
+            starts[c + 1] += 1;
+        }
+        for c in 0..self.len() {
+            starts[c + 1] += starts[c];
+        }
+        let mut fill = starts.clone();
+        let mut order = vec![0usize; points.len()];
+        for (i, &c) in cells.iter().enumerate() {
+            order[fill[c]] = i;
+            fill[c] += 1;
+        }
+        (starts, order)
+    }
+
+    /// Bilinear interpolation at `p` of a field given at the cell centres.
+    fn interpolate(&self, field: &[Vec2], p: Point2) -> Vec2 {
+        let axis = |v: f64, n: usize| {
+            let t = ((v / self.cell) - 0.5).clamp(0.0, (n - 1) as f64);
+            let i0 = (t.floor() as usize).min(n.saturating_sub(2));
+            let i1 = (i0 + 1).min(n - 1);
+            (i0, i1, t - i0 as f64)
+        };
+        let (x0, x1, fx) = axis(p.x - self.origin.x, self.nx);
+        let (y0, y1, fy) = axis(p.y - self.origin.y, self.ny);
+        let at = |cx: usize, cy: usize| field[cy * self.nx + cx];
+        let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
+        let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+}
+
+/// One voting pass: per cell of `grid`, the residual displacement of its points of `a`
+/// beyond their `prior`, searched within `radius` of each point's `prior` displacement with bins of `bin`
+/// px; invalid cells are filled from their neighbours. `None` when no cell has a peak.
+fn vote_field(
+    a: &[Point2],
+    b: &[Point2],
+    prior: &[Vec2],
+    grid: &Grid,
+    radius: f64,
+    bin: f64,
+) -> Option<Vec<Vec2>> {
+    let (a_starts, a_order) = grid.bucket(a);
+    let (b_starts, b_order) = grid.bucket(b);
+    let half = (radius / bin).ceil() as usize;
+    let side = 2 * half + 1;
+    let mut histogram = vec![0u32; side * side];
+    let mut peak_votes = Vec::new();
+    let reach = (radius / grid.cell).ceil() as usize;
+    let mut field: Vec<Option<Vec2>> = vec![None; grid.len()];
+    for (c, slot) in field.iter_mut().enumerate() {
+        let members = &a_order[a_starts[c]..a_starts[c + 1]];
+        if members.is_empty() {
+            continue;
+        }
+        // Every pair (point of the cell, point of b near its prior target) as a residual
+        // displacement within `radius`.
+        let for_each_pair = |visit: &mut dyn FnMut(Vec2)| {
+            for &i in members {
+                let target = a[i] + prior[i];
+                let (tx, ty) = grid.cell_of(target);
+                for cy in ty.saturating_sub(reach)..=(ty + reach).min(grid.ny - 1) {
+                    for cx in tx.saturating_sub(reach)..=(tx + reach).min(grid.nx - 1) {
+                        let cb = cy * grid.nx + cx;
+                        for &k in &b_order[b_starts[cb]..b_starts[cb + 1]] {
+                            let d = b[k] - target;
+                            if d.norm() <= radius {
+                                visit(d);
+                            }
+                        }
+                    }
+                }
+            }
+        };
+        histogram.fill(0);
+        let mut votes = 0u64;
+        for_each_pair(&mut |d| {
+            let ix = ((d.x / bin).round() as i64 + half as i64) as usize;
+            let iy = ((d.y / bin).round() as i64 + half as i64) as usize;
+            histogram[iy.min(side - 1) * side + ix.min(side - 1)] += 1;
+            votes += 1;
+        });
+        let (peak_count, peak) = peak_3x3(&histogram, side);
+        // Random pairs spread over the search disc: their expected count in 3×3 bins.
+        let expected = votes as f64 * 9.0 / (std::f64::consts::PI * (radius / bin).powi(2));
+        let significant = (peak_count as f64) >= MIN_PEAK_VOTES
+            && (peak_count as f64) > expected + PEAK_SIGMAS * expected.sqrt();
+        if !significant {
+            continue;
+        }
+        let centre = Vec2::new(
+            (peak.0 as f64 - half as f64) * bin,
+            (peak.1 as f64 - half as f64) * bin,
+        );
+        // The median of the votes near the peak: robust to the random pairs among them.
+        peak_votes.clear();
+        for_each_pair(&mut |d| {
+            if (d - centre).max_abs() <= 1.5 * bin {
+                peak_votes.push(d);
+            }
+        });
+        *slot = Some(median_vec(&peak_votes));
+    }
+    reject_outliers(&mut field, grid, bin);
+    fill_gaps(field, grid)
+}
+
+/// The bin whose 3×3 neighbourhood holds the most votes (ties to the first in raster
+/// order) and that count.
+fn peak_3x3(histogram: &[u32], side: usize) -> (u32, (usize, usize)) {
+    let mut best = (0u32, (side / 2, side / 2));
+    for y in 0..side {
+        for x in 0..side {
+            if histogram[y * side + x] == 0 {
+                continue;
+            }
+            let mut sum = 0;
+            for yy in y.saturating_sub(1)..=(y + 1).min(side - 1) {
+                for xx in x.saturating_sub(1)..=(x + 1).min(side - 1) {
+                    sum += histogram[yy * side + xx];
+                }
+            }
+            if sum > best.0 {
+                best = (sum, (x, y));
+            }
+        }
+    }
+    best
+}
+
+/// The valid values among the 8 neighbours of cell (cx, cy).
+fn neighbours(field: &[Option<Vec2>], grid: &Grid, cx: usize, cy: usize) -> Vec<Vec2> {
+    let mut out = Vec::with_capacity(8);
+    for y in cy.saturating_sub(1)..=(cy + 1).min(grid.ny - 1) {
+        for x in cx.saturating_sub(1)..=(cx + 1).min(grid.nx - 1) {
+            if (x, y) != (cx, cy)
+                && let Some(v) = field[y * grid.nx + x]
+            {
+                out.push(v);
+            }
+        }
+    }
+    out
+}
+
+/// Component-wise median (of a non-empty set).
+fn median_vec(values: &[Vec2]) -> Vec2 {
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let n = v.len();
+        if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            0.5 * (v[n / 2 - 1] + v[n / 2])
+        }
+    };
+    Vec2::new(
+        median(values.iter().map(|v| v.x).collect()),
+        median(values.iter().map(|v| v.y).collect()),
+    )
+}
+
+/// Normalised median test on every valid cell with at least two valid neighbours: a cell
+/// whose residual to the neighbours' median exceeds the threshold becomes invalid. All
+/// cells are tested against the field as it was before the test.
+fn reject_outliers(field: &mut [Option<Vec2>], grid: &Grid, bin: f64) {
+    let floor = MEDIAN_TEST_FLOOR_BINS * bin;
+    let mut outliers = Vec::new();
+    for cy in 0..grid.ny {
+        for cx in 0..grid.nx {
+            let Some(v) = field[cy * grid.nx + cx] else {
+                continue;
+            };
+            let around = neighbours(field, grid, cx, cy);
+            if around.len() < 2 {
+                continue;
+            }
+            let median = median_vec(&around);
+            let spread: Vec<Vec2> = around
+                .iter()
+                .map(|&u| Vec2::new((u.x - median.x).abs(), (u.y - median.y).abs()))
+                .collect();
+            let scale = median_vec(&spread);
+            let rx = (v.x - median.x).abs() / (scale.x + floor);
+            let ry = (v.y - median.y).abs() / (scale.y + floor);
+            if rx.max(ry) > MEDIAN_TEST_THRESHOLD {
+                outliers.push(cy * grid.nx + cx);
+            }
+        }
+    }
+    for c in outliers {
+        field[c] = None;
+    }
+}
+
+/// Fills invalid cells with the median of their valid neighbours, ring after ring, until
+/// every cell has a value; `None` when no cell is valid.
+fn fill_gaps(mut field: Vec<Option<Vec2>>, grid: &Grid) -> Option<Vec<Vec2>> {
+    if field.iter().all(Option::is_none) {
+        return None;
+    }
+    while field.iter().any(Option::is_none) {
+        let mut filled = field.clone();
+        for cy in 0..grid.ny {
+            for cx in 0..grid.nx {
+                let c = cy * grid.nx + cx;
+                if field[c].is_none() {
+                    let around = neighbours(&field, grid, cx, cy);
+                    if !around.is_empty() {
+                        filled[c] = Some(median_vec(&around));
+                    }
+                }
+            }
+        }
+        field = filled;
+    }
+    Some(field.into_iter().flatten().collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    use rand::RngExt;
+
+    /// `n` uniformly random points in a `side × side` square (seeded).
+    fn random_points(n: usize, side: f64) -> Vec<Point2> {
+        let mut rng = sillage_core::rng_stream(3, 0);
+        (0..n)
+            .map(|_| Point2::new(rng.random_range(0.0..side), rng.random_range(0.0..side)))
+            .collect()
+    }
+
+    #[test]
+    fn uniform_shift_larger_than_the_spacing_is_found() {
+        let a = random_points(1600, 400.0);
+        let shift = Vec2::new(23.3, -17.8);
+        let b: Vec<Point2> = a.iter().map(|&p| p + shift).collect();
+        let mut out = Vec::new();
+        assert!(voted_displacements(&a, &b, None, 40.0, &mut out).is_some());
+        assert_eq!(out.len(), a.len());
+        for d in &out {
+            assert!((*d - shift).norm() < 0.05, "{d:?}");
+        }
+    }
+
+    #[test]
+    fn smooth_rotation_is_followed() {
+        // Rigid rotation about the centre: displacements up to 4× the spacing (10 px).
+        let a = random_points(3600, 600.0);
+        let centre = Point2::new(300.0, 300.0);
+        let angle: f64 = 0.1;
+        let (s, c) = angle.sin_cos();
+        let moved = |p: Point2| {
+            let r = p - centre;
+            centre + Vec2::new(c * r.x - s * r.y, s * r.x + c * r.y)
+        };
+        let b: Vec<Point2> = a.iter().map(|&p| moved(p)).collect();
+        let mut out = Vec::new();
+        assert!(voted_displacements(&a, &b, None, 40.0, &mut out).is_some());
+        let spacing = 10.0;
+        let within_half_spacing = a
+            .iter()
+            .zip(&out)
+            .filter(|&(&p, &d)| ((p + d) - moved(p)).norm() < spacing / 2.0)
+            .count();
+        assert!(
+            within_half_spacing as f64 > 0.97 * a.len() as f64,
+            "{within_half_spacing} of {}",
+            a.len()
+        );
+    }
+
+    #[test]
+    fn no_motion_to_find_without_points() {
+        let mut out = vec![Vec2::ZERO];
+        assert!(voted_displacements(&[], &[Point2::new(1.0, 1.0)], None, 10.0, &mut out).is_none());
+        assert!(out.is_empty());
+    }
+}
