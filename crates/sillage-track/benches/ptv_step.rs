@@ -2,7 +2,8 @@
 //! 1k, 5k and 25k particles at the density of 25,000 particles in a 2048² frame.
 //!
 //! The tracker is warmed up on 8 frames (motion model and threshold settled); each sample
-//! times the step of the 9th frame on a clone of it.
+//! times the step of the 9th frame on a clone of it. Two configurations: TracTrac's
+//! (`default`) and with displacement voting within 10 px (`voting`).
 
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -41,25 +42,31 @@ fn sequence(n: usize, frames: usize) -> Vec<Vec<Detection>> {
 fn ptv_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("ptv_step");
     group.sample_size(20);
-    for n in [1_000, 5_000, 25_000] {
-        let frames = sequence(n, WARM_FRAMES + 1);
-        let mut warmed = PtvTracker::new(PtvParams::default()).expect("default params");
-        let mut sink: Vec<TrackPoint> = Vec::new();
-        for (f, d) in frames[..WARM_FRAMES].iter().enumerate() {
-            let obs = FrameObservations::from_detections(f as u64, d);
-            warmed.step(&obs, &mut sink).expect("step");
+    let voting = PtvParams {
+        vote_search_px: Some(10.0),
+        ..Default::default()
+    };
+    for (name, params) in [("default", PtvParams::default()), ("voting", voting)] {
+        for n in [1_000, 5_000, 25_000] {
+            let frames = sequence(n, WARM_FRAMES + 1);
+            let mut warmed = PtvTracker::new(params.clone()).expect("valid params");
+            let mut sink: Vec<TrackPoint> = Vec::new();
+            for (f, d) in frames[..WARM_FRAMES].iter().enumerate() {
+                let obs = FrameObservations::from_detections(f as u64, d);
+                warmed.step(&obs, &mut sink).expect("step");
+            }
+            let last = FrameObservations::from_detections(WARM_FRAMES as u64, &frames[WARM_FRAMES]);
+            group.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
+                b.iter_batched(
+                    || (warmed.clone(), Vec::<TrackPoint>::with_capacity(n)),
+                    |(mut tracker, mut out)| {
+                        tracker.step(black_box(&last), &mut out).expect("step");
+                        out
+                    },
+                    BatchSize::LargeInput,
+                )
+            });
         }
-        let last = FrameObservations::from_detections(WARM_FRAMES as u64, &frames[WARM_FRAMES]);
-        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
-            b.iter_batched(
-                || (warmed.clone(), Vec::<TrackPoint>::with_capacity(n)),
-                |(mut tracker, mut out)| {
-                    tracker.step(black_box(&last), &mut out).expect("step");
-                    out
-                },
-                BatchSize::LargeInput,
-            )
-        });
     }
     group.finish();
 }

@@ -322,7 +322,7 @@ fn outlier_filter_rejects_an_injected_wrong_link_and_keeps_the_id() {
 #[test]
 fn output_does_not_depend_on_the_number_of_threads() {
     let scene = rotating(6, 3000, (0.04, 0.0), 12, 0.9, 50);
-    let run = |threads: usize| {
+    let run = |threads: usize, vote_search_px| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
@@ -330,14 +330,17 @@ fn output_does_not_depend_on_the_number_of_threads() {
         pool.install(|| {
             let params = PtvParams {
                 motion_it: 1,
+                vote_search_px,
                 ..Default::default()
             };
             scene.track(params)
         })
     };
-    let (one, two) = (run(1), run(2));
-    assert!(!one.is_empty());
-    assert_eq!(format!("{one:?}"), format!("{two:?}"));
+    for vote_search_px in [None, Some(20.0)] {
+        let (one, three) = (run(1, vote_search_px), run(3, vote_search_px));
+        assert!(!one.is_empty());
+        assert_eq!(format!("{one:?}"), format!("{three:?}"));
+    }
 }
 
 #[test]

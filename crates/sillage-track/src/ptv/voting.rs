@@ -16,6 +16,7 @@
 //! (PIV's multi-pass refinement). Each point's displacement is its prior plus the bilinear
 //! interpolation of the residual fields.
 
+use rayon::prelude::*;
 use sillage_core::{Point2, Vec2};
 
 /// Points of frame `a` per cell of the first pass: enough votes for a clear peak.
@@ -202,63 +203,68 @@ fn vote_field(
     let (b_starts, b_order) = grid.bucket(b);
     let half = (radius / bin).ceil() as usize;
     let side = 2 * half + 1;
-    let mut histogram = vec![0u32; side * side];
-    let mut peak_votes = Vec::new();
     let reach = (radius / grid.cell).ceil() as usize;
+    let radius_sq = radius * radius;
+    // Cells are independent: voted in parallel, each with its own histogram, so the result
+    // does not depend on the number of threads.
     let mut field: Vec<Option<Vec2>> = vec![None; grid.len()];
-    for (c, slot) in field.iter_mut().enumerate() {
-        let members = &a_order[a_starts[c]..a_starts[c + 1]];
-        if members.is_empty() {
-            continue;
-        }
-        // Every pair (point of the cell, point of b near its prior target) as a residual
-        // displacement within `radius`.
-        let for_each_pair = |visit: &mut dyn FnMut(Vec2)| {
-            for &i in members {
-                let target = a[i] + prior[i];
-                let (tx, ty) = grid.cell_of(target);
-                for cy in ty.saturating_sub(reach)..=(ty + reach).min(grid.ny - 1) {
-                    for cx in tx.saturating_sub(reach)..=(tx + reach).min(grid.nx - 1) {
-                        let cb = cy * grid.nx + cx;
-                        for &k in &b_order[b_starts[cb]..b_starts[cb + 1]] {
-                            let d = b[k] - target;
-                            if d.norm() <= radius {
-                                visit(d);
+    let scratch = || (vec![0u32; side * side], Vec::new());
+    field.par_iter_mut().enumerate().for_each_init(
+        scratch,
+        |(histogram, peak_votes), (c, slot)| {
+            let members = &a_order[a_starts[c]..a_starts[c + 1]];
+            if members.is_empty() {
+                return;
+            }
+            // Every pair (point of the cell, point of b near its prior target) as a residual
+            // displacement within `radius`.
+            let for_each_pair = |visit: &mut dyn FnMut(Vec2)| {
+                for &i in members {
+                    let target = a[i] + prior[i];
+                    let (tx, ty) = grid.cell_of(target);
+                    for cy in ty.saturating_sub(reach)..=(ty + reach).min(grid.ny - 1) {
+                        for cx in tx.saturating_sub(reach)..=(tx + reach).min(grid.nx - 1) {
+                            let cb = cy * grid.nx + cx;
+                            for &k in &b_order[b_starts[cb]..b_starts[cb + 1]] {
+                                let d = b[k] - target;
+                                if d.x * d.x + d.y * d.y <= radius_sq {
+                                    visit(d);
+                                }
                             }
                         }
                     }
                 }
+            };
+            histogram.fill(0);
+            let mut votes = 0u64;
+            for_each_pair(&mut |d| {
+                let ix = ((d.x / bin).round() as i64 + half as i64) as usize;
+                let iy = ((d.y / bin).round() as i64 + half as i64) as usize;
+                histogram[iy.min(side - 1) * side + ix.min(side - 1)] += 1;
+                votes += 1;
+            });
+            let (peak_count, peak) = peak_3x3(histogram, side);
+            // Random pairs spread over the search disc: their expected count in 3×3 bins.
+            let expected = votes as f64 * 9.0 / (std::f64::consts::PI * (radius / bin).powi(2));
+            let significant = (peak_count as f64) >= MIN_PEAK_VOTES
+                && (peak_count as f64) > expected + PEAK_SIGMAS * expected.sqrt();
+            if !significant {
+                return;
             }
-        };
-        histogram.fill(0);
-        let mut votes = 0u64;
-        for_each_pair(&mut |d| {
-            let ix = ((d.x / bin).round() as i64 + half as i64) as usize;
-            let iy = ((d.y / bin).round() as i64 + half as i64) as usize;
-            histogram[iy.min(side - 1) * side + ix.min(side - 1)] += 1;
-            votes += 1;
-        });
-        let (peak_count, peak) = peak_3x3(&histogram, side);
-        // Random pairs spread over the search disc: their expected count in 3×3 bins.
-        let expected = votes as f64 * 9.0 / (std::f64::consts::PI * (radius / bin).powi(2));
-        let significant = (peak_count as f64) >= MIN_PEAK_VOTES
-            && (peak_count as f64) > expected + PEAK_SIGMAS * expected.sqrt();
-        if !significant {
-            continue;
-        }
-        let centre = Vec2::new(
-            (peak.0 as f64 - half as f64) * bin,
-            (peak.1 as f64 - half as f64) * bin,
-        );
-        // The median of the votes near the peak: robust to the random pairs among them.
-        peak_votes.clear();
-        for_each_pair(&mut |d| {
-            if (d - centre).max_abs() <= 1.5 * bin {
-                peak_votes.push(d);
-            }
-        });
-        *slot = Some(median_vec(&peak_votes));
-    }
+            let centre = Vec2::new(
+                (peak.0 as f64 - half as f64) * bin,
+                (peak.1 as f64 - half as f64) * bin,
+            );
+            // The median of the votes near the peak: robust to the random pairs among them.
+            peak_votes.clear();
+            for_each_pair(&mut |d| {
+                if (d - centre).max_abs() <= 1.5 * bin {
+                    peak_votes.push(d);
+                }
+            });
+            *slot = Some(median_vec(peak_votes));
+        },
+    );
     reject_outliers(&mut field, grid, bin);
     fill_gaps(field, grid)
 }
