@@ -1,8 +1,10 @@
 //! The command-line grammar (clap): `sillage <verb> [<kind>] INPUT... [options]`.
 
 use std::path::PathBuf;
+use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use sillage::eval::mot::{MotChallengeProtocol, MotConvention, Similarity};
 
 /// Follow many moving objects through image sequences (PTV, bedload beads, pedestrians).
 #[derive(Debug, Parser)]
@@ -20,6 +22,8 @@ const EXAMPLES: &str = "Examples:
   sillage ptv frames/ --tractrac-par tifseq_par.txt --out tracks.csv
   sillage synth vortex --out vortex/ --frames 50 --particles 2000 --snr 6
   sillage eval ptv --truth vortex/truth.csv --tracks tracks.csv
+  sillage eval mot --gt MOT17/train --pred tracker/data --protocol mot17
+  sillage eval mot --gt vortex/truth.csv --pred tracks.csv --match dist:1 --json
   sillage bench ptv --particles 1000,5000,25000";
 
 /// The verbs.
@@ -135,6 +139,9 @@ pub struct VortexArgs {
 pub enum EvalCommand {
     /// PTV indexes of the TracTrac paper: true/false recovery, position and displacement errors.
     Ptv(EvalPtvArgs),
+    /// Multi-object tracking scores (HOTA, CLEAR MOT, IDF1; the papers' own with --papers)
+    /// per sequence and combined.
+    Mot(EvalMotArgs),
 }
 
 /// `sillage eval ptv`.
@@ -152,6 +159,177 @@ pub struct EvalPtvArgs {
     /// Print the result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `sillage eval mot`.
+#[derive(Debug, Args)]
+pub struct EvalMotArgs {
+    /// Ground truth: a MOTChallenge gt.txt, a sequence folder (SEQ/gt/gt.txt, SEQ/seqinfo.ini),
+    /// a folder of sequence folders, a bead ground-truth CSV (frame,id,x,y,category,...) or a
+    /// truth CSV (frame,track_id,x,y).
+    #[arg(long, value_name = "FILE_OR_DIR")]
+    pub gt: PathBuf,
+    /// Predictions: a MOTChallenge results file, a folder of files named after the sequences
+    /// (<seq>.txt), a sillage track file (TracTrac _track.txt, CSV, Parquet) or a bead CSV.
+    #[arg(long, value_name = "FILE_OR_DIR")]
+    pub pred: PathBuf,
+    /// How a prediction matches a true object: iou[:T] (box IoU ≥ T, default 0.5), dist:R
+    /// (centres at most R px apart), disc[:T] (bead disc IoU ≥ T, default 0.43).
+    #[arg(long = "match", value_name = "RULE", default_value = "iou")]
+    pub rule: MatchRule,
+    /// MOTChallenge ground-truth rules: which rows are scored, which are distractors.
+    #[arg(long, value_enum, default_value_t = ProtocolArg::Mot15)]
+    pub protocol: ProtocolArg,
+    /// Whose conventions to follow where the reference evaluators differ.
+    #[arg(long, value_enum, default_value_t = ConventionArg::Trackeval)]
+    pub convention: ConventionArg,
+    /// Also print the papers' own scores: MMPF+ correct tracks, FN/FP rates and motion-state
+    /// F-scores, IMM-PF's VACE, SIFT-PF's ETISEO M1-M3.
+    #[arg(long)]
+    pub papers: bool,
+    /// Print the results as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Write every frame's events (match, switch, miss, false positive) to this CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    pub per_frame: Option<PathBuf>,
+}
+
+/// `--match`: how the similarity of a prediction and a true object is measured, and the
+/// least similarity of a match.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MatchRule {
+    /// Box IoU at least `threshold`.
+    Iou {
+        /// Least IoU.
+        threshold: f64,
+    },
+    /// Centres at most `radius_px` apart.
+    Distance {
+        /// Largest distance, px.
+        radius_px: f64,
+    },
+    /// Disc IoU (beads) at least `threshold`.
+    Disc {
+        /// Least IoU.
+        threshold: f64,
+    },
+}
+
+impl MatchRule {
+    /// The similarity measure. `dist:R` is TrackEval's Euclidean similarity vanishing at
+    /// `2R`, so that the threshold 0.5 accepts exactly the centres within `R`.
+    pub fn similarity(self) -> Similarity {
+        match self {
+            MatchRule::Iou { .. } => Similarity::BoxIou,
+            MatchRule::Distance { radius_px } => Similarity::Distance {
+                zero_distance_px: 2.0 * radius_px,
+            },
+            MatchRule::Disc { .. } => Similarity::DiscIou,
+        }
+    }
+
+    /// The least similarity of a match.
+    pub fn threshold(self) -> f64 {
+        match self {
+            MatchRule::Iou { threshold } | MatchRule::Disc { threshold } => threshold,
+            MatchRule::Distance { .. } => 0.5,
+        }
+    }
+}
+
+impl std::fmt::Display for MatchRule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MatchRule::Iou { threshold } => write!(f, "iou:{threshold} (box IoU ≥ {threshold})"),
+            MatchRule::Distance { radius_px } => {
+                write!(f, "dist:{radius_px} (centres at most {radius_px} px apart)")
+            }
+            MatchRule::Disc { threshold } => {
+                write!(f, "disc:{threshold} (bead disc IoU ≥ {threshold})")
+            }
+        }
+    }
+}
+
+impl FromStr for MatchRule {
+    type Err = String;
+
+    /// Parses `iou[:T]`, `dist:R` or `disc[:T]`.
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (kind, value) = match text.split_once(':') {
+            Some((kind, value)) => (kind, Some(value)),
+            None => (text, None),
+        };
+        let number = |value: &str, what: &str, valid: fn(f64) -> bool| {
+            value
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|&v| valid(v))
+                .ok_or_else(|| format!("`{value}` is not {what}"))
+        };
+        let threshold = |default: f64| match value {
+            Some(v) => number(v, "an IoU in (0, 1]", |t| t > 0.0 && t <= 1.0),
+            None => Ok(default),
+        };
+        match kind.trim().to_ascii_lowercase().as_str() {
+            "iou" => Ok(MatchRule::Iou {
+                threshold: threshold(0.5)?,
+            }),
+            "disc" => Ok(MatchRule::Disc {
+                threshold: threshold(0.43)?,
+            }),
+            "dist" => {
+                let value = value.ok_or("dist needs a distance in px, e.g. dist:5")?;
+                Ok(MatchRule::Distance {
+                    radius_px: number(value, "a distance > 0 (px)", |r| r.is_finite() && r > 0.0)?,
+                })
+            }
+            _ => Err(format!(
+                "`{text}` is not a matching rule; use iou[:T], dist:R or disc[:T]"
+            )),
+        }
+    }
+}
+
+/// `--protocol`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum ProtocolArg {
+    /// 2D MOT 2015: rows with a zero consider flag are ignored; no classes.
+    Mot15,
+    /// MOT16/17: pedestrians scored, distractor classes removed.
+    Mot17,
+    /// MOT20: as MOT17, non-motorised vehicles also distractors.
+    Mot20,
+}
+
+impl From<ProtocolArg> for MotChallengeProtocol {
+    fn from(p: ProtocolArg) -> Self {
+        match p {
+            ProtocolArg::Mot15 => MotChallengeProtocol::Mot15,
+            ProtocolArg::Mot17 => MotChallengeProtocol::Mot17,
+            ProtocolArg::Mot20 => MotChallengeProtocol::Mot20,
+        }
+    }
+}
+
+/// `--convention`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum ConventionArg {
+    /// TrackEval, MOTChallenge's official evaluator.
+    Trackeval,
+    /// py-motmetrics 1.4.0.
+    Pymotmetrics,
+}
+
+impl From<ConventionArg> for MotConvention {
+    fn from(c: ConventionArg) -> Self {
+        match c {
+            ConventionArg::Trackeval => MotConvention::TrackEval,
+            ConventionArg::Pymotmetrics => MotConvention::PyMotMetrics,
+        }
+    }
 }
 
 /// `sillage demo`.

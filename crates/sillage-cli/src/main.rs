@@ -7,6 +7,8 @@ mod bench;
 mod cli;
 mod demo;
 mod eval;
+mod eval_inputs;
+mod eval_mot;
 mod progress;
 mod ptv;
 mod synth;
@@ -19,6 +21,7 @@ fn main() {
         cli::Command::Ptv(a) => ptv::run(&a),
         cli::Command::Synth(cli::SynthCommand::Vortex(a)) => synth::run_vortex(&a),
         cli::Command::Eval(cli::EvalCommand::Ptv(a)) => eval::run_ptv(&a),
+        cli::Command::Eval(cli::EvalCommand::Mot(a)) => eval_mot::run(&a),
         cli::Command::Demo(a) => demo::run(&a),
         cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
         cli::Command::Config(a) => ptv::print_config(&a),

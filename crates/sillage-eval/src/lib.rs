@@ -6,6 +6,8 @@
 //! - [`ptv_accuracy`]: the four accuracy indexes of the TracTrac paper (§4.1.2, Fig. 4):
 //!   true and false recovery rates, mean position and displacement errors.
 //! - [`detection_scores`]: recall, precision and localisation error of a detector.
+//! - [`papers`]: each paper's own scores — MMPF+ correct tracks and motion-state F-scores,
+//!   IMM-PF's VACE (SFDA, ATA, N-MODP, MOTP), SIFT-PF's ETISEO M1–M3 — on the same matching.
 //!
 //! Metrics only read their inputs; inputs need not be sorted.
 //!
@@ -26,6 +28,7 @@
 pub mod detection;
 mod matching;
 pub mod mot;
+pub mod papers;
 pub mod ptv;
 mod summary;
 

@@ -37,9 +37,52 @@ pub(crate) fn score(value: f64) -> String {
     format!("{:.3}", 100.0 * value)
 }
 
+/// An optional score as [`score`], or `n/a`.
+pub(crate) fn optional_score(value: Option<f64>) -> String {
+    value.map_or_else(|| "n/a".to_owned(), score)
+}
+
 /// A count.
 pub(crate) fn count(value: u64) -> String {
     value.to_string()
+}
+
+/// The columns of one metric family for one row of a report (`None`: the row has no value
+/// for this family).
+pub(crate) type FamilyColumns<T> = fn(&T) -> Option<Vec<(&'static str, String)>>;
+
+/// Writes one table per metric family (`(title, columns)`), each with a row per named item
+/// that has values for it; a family without any row is left out.
+pub(crate) fn family_tables<T>(
+    f: &mut std::fmt::Formatter<'_>,
+    rows: &[(&str, &T)],
+    families: &[(String, FamilyColumns<T>)],
+) -> std::fmt::Result {
+    let mut first = true;
+    for (title, columns) in families {
+        let mut table: Option<Table> = None;
+        for (name, item) in rows {
+            let Some(values) = columns(item) else {
+                continue;
+            };
+            let table = table.get_or_insert_with(|| {
+                let header = values.iter().map(|(column, _)| (*column).to_owned());
+                Table::new(std::iter::once("sequence".to_owned()).chain(header))
+            });
+            table.push(
+                std::iter::once((*name).to_owned()).chain(values.into_iter().map(|(_, v)| v)),
+            );
+        }
+        if let Some(table) = table {
+            if !first {
+                writeln!(f)?;
+            }
+            first = false;
+            writeln!(f, "{title}")?;
+            write!(f, "{table}")?;
+        }
+    }
+    Ok(())
 }
 
 /// A plain-text table: a header row and value rows, columns right-aligned to their widest

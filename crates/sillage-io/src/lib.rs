@@ -13,7 +13,10 @@
 //! - [`read_tractrac_par`] / [`write_tractrac_par`] for TracTrac's `*_par.txt`;
 //! - [`read_mot_sequence`] / [`read_mot_rows`] / [`read_seqinfo`] for MOTChallenge
 //!   `gt.txt`, `det.txt`, results and `seqinfo.ini` (a file or a sequence folder), and
-//!   [`MotResultsWriter`] / [`write_mot_results`] for results.
+//!   [`MotResultsWriter`] / [`write_mot_results`] for results;
+//! - [`MotEventsCsvWriter`] for the per-frame events of an evaluation;
+//! - [`read_bead_csv`] / [`read_bead_sequence_params`] for bead ground truth with categories
+//!   and motion states (BeadTracking, the MMPF+ paper's code).
 //!
 //! Every file is written as `.NAME.partial` in the destination folder and renamed when
 //! complete. Errors name the file, the line or frame, and the fix.
@@ -51,15 +54,21 @@
 //! # }
 //! ```
 
+mod beads;
 mod detections;
 mod frames;
 mod mot;
+mod mot_events;
 mod partial;
 mod text_table;
 mod tracks;
 mod tractrac_par;
 mod truth;
 
+pub use beads::{
+    BEAD_HEADER, BeadCategory, BeadPoint, BeadSequenceParams, parse_bead_sequence_params,
+    read_bead_csv, read_bead_sequence_params,
+};
 pub use detections::{
     DETECTIONS_HEADER, DetectionsCsvWriter, read_detections_csv, write_detections_csv,
 };
@@ -68,6 +77,7 @@ pub use mot::{
     MotFileRole, MotResultsWriter, MotRow, MotSequenceFile, SeqInfo, parse_mot_rows, parse_seqinfo,
     read_mot_rows, read_mot_sequence, read_seqinfo, write_mot_results,
 };
+pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
 pub use tracks::{
     TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackWriter,
     WrittenSummary, create_track_writer, read_tracks,

@@ -2,7 +2,8 @@
 
 use proptest::prelude::*;
 use sillage_io::{
-    TrackFormat, parse_tractrac_par, read_detections_csv, read_tracks, read_truth_csv,
+    TrackFormat, parse_bead_sequence_params, parse_tractrac_par, read_bead_csv,
+    read_detections_csv, read_tracks, read_truth_csv,
 };
 
 proptest! {
@@ -32,6 +33,7 @@ proptest! {
             "frame,particle,x,y",
             "frame,track_id,x,y,vx,vy",
             "frame,x,y,strength",
+            "frame,id,x,y,category,vx,vy,motion_state",
             "# TracTrac v3.0",
             "",
         ]),
@@ -43,6 +45,12 @@ proptest! {
         let _ = read_tracks(&path, TrackFormat::Tractrac);
         let _ = read_truth_csv(&path);
         let _ = read_detections_csv(&path);
+        let _ = read_bead_csv(&path);
+    }
+
+    #[test]
+    fn bead_parameter_parser_never_panics(text in "[A-Za-z \t\n0-9.eE+-]{0,200}") {
+        let _ = parse_bead_sequence_params(std::path::Path::new("sequence_param.txt"), &text);
     }
 
     #[test]
@@ -53,5 +61,6 @@ proptest! {
         let _ = read_tracks(&path, TrackFormat::Csv);
         let _ = read_tracks(&path, TrackFormat::Tractrac);
         let _ = read_truth_csv(&path);
+        let _ = read_bead_csv(&path);
     }
 }

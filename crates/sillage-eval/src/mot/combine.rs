@@ -10,10 +10,7 @@ use super::MotMetrics;
 use super::clear::ClearMetrics;
 use super::hota::HotaMetrics;
 use super::identity::IdentityMetrics;
-use crate::summary::Table;
-
-/// The columns of one metric family of a sequence.
-type Columns = fn(&MotMetrics) -> Vec<(&'static str, String)>;
+use crate::summary::{FamilyColumns, family_tables};
 
 impl MotMetrics {
     /// Combines sequences: each family as TrackEval's `combine_sequences` (see
@@ -69,24 +66,11 @@ impl fmt::Display for MotReport {
             .chain([("COMBINED", &self.combined)])
             .collect();
         let c = &self.combined;
-        let families: [(String, Columns); 3] = [
-            (c.hota.title(), |m| m.hota.columns()),
-            (c.clear.title(), |m| m.clear.columns()),
-            (c.identity.title(), |m| m.identity.columns()),
+        let families: [(String, FamilyColumns<MotMetrics>); 3] = [
+            (c.hota.title(), |m| Some(m.hota.columns())),
+            (c.clear.title(), |m| Some(m.clear.columns())),
+            (c.identity.title(), |m| Some(m.identity.columns())),
         ];
-        for (k, (title, columns)) in families.iter().enumerate() {
-            if k > 0 {
-                writeln!(f)?;
-            }
-            writeln!(f, "{title}")?;
-            let header = columns(c).into_iter().map(|(name, _)| name.to_owned());
-            let mut table = Table::new(std::iter::once("sequence".to_owned()).chain(header));
-            for (name, metrics) in &rows {
-                let values = columns(metrics).into_iter().map(|(_, value)| value);
-                table.push(std::iter::once((*name).to_owned()).chain(values));
-            }
-            table.fmt(f)?;
-        }
-        Ok(())
+        family_tables(f, &rows, &families)
     }
 }

@@ -541,9 +541,10 @@ fn check_objects<'a>(
     for (frame, id, shape) in items {
         if let Some(count) = frame_count.filter(|&count| frame >= count) {
             return Err(Error::input(format!(
-                "{what} id {id} is in frame {frame} (0-based), beyond the sequence's {count} \
-                 frames; cut the file to the sequence length or check that it belongs to \
-                 this sequence"
+                "{what} id {id} is in frame {frame} (0-based; {} in 1-based files such as \
+                 MOTChallenge's), beyond the sequence's {count} frames; cut the file to the \
+                 sequence length or check that it belongs to this sequence",
+                frame.saturating_add(1)
             )));
         }
         if let Some(defect) = shape.defect() {

@@ -30,13 +30,13 @@
 //! # Ok::<(), sillage_core::Error>(())
 //! ```
 
-mod assignment;
+pub(crate) mod assignment;
 mod clear;
 mod combine;
 mod data;
 mod hota;
 mod identity;
-mod ids;
+pub(crate) mod ids;
 mod params;
 mod similarity;
 

@@ -5,7 +5,8 @@ use sillage_core::{Error, Result};
 
 /// Parameters of [`crate::ptv::PtvTracker`]. Keys and defaults are those of TracTrac's
 /// parameter file as its command line fills them in (`set_default_parameter`), so a
-/// TracTrac `*_par.txt` maps one to one; `vote_search_px`, `max_displacement_px` and `dt`
+/// TracTrac `*_par.txt` maps one to one; `vote_search_px`, `ambiguity_ratio`, `max_displacement_px`
+/// and `dt`
 /// are additions.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -31,6 +32,13 @@ pub struct PtvParams {
     /// expected error of a zero-motion guess, i.e. the largest displacement; default `None`
     /// (TracTrac's behaviour: the prediction is the model alone, zero at the start).
     pub vote_search_px: Option<f64>,
+    /// Ambiguity (ratio) test, for flows where objects appear and vanish (intermittency):
+    /// a link is dropped when the nearest point of frame t to the prediction is not
+    /// clearly nearer than the second, `d₁ > ambiguity_ratio · d₂` (Lowe's ratio test).
+    /// A correct link sits at the prediction's error from it, far closer than the spacing;
+    /// a point that appeared at random does not. 0.3 is a good value; default `None`
+    /// (TracTrac's behaviour). In fast flows, use it with `vote_search_px`.
+    pub ambiguity_ratio: Option<f64>,
     /// Reject pairs whose displacement exceeds this many px (TracTrac has no such gate);
     /// default `None`.
     pub max_displacement_px: Option<f64>,
@@ -48,6 +56,7 @@ impl Default for PtvParams {
             filter_std: 1.5,
             filter_time: 1.0,
             vote_search_px: None,
+            ambiguity_ratio: None,
             max_displacement_px: None,
             dt: 1.0,
         }
@@ -96,6 +105,15 @@ impl PtvParams {
                 radius,
                 "must be a finite number > 0 (the largest expected displacement, px), or \
                  absent for no displacement voting",
+            ));
+        }
+        if let Some(ratio) = self.ambiguity_ratio
+            && !(ratio > 0.0 && ratio <= 1.0)
+        {
+            return Err(Error::parameter(
+                "ambiguity_ratio",
+                ratio,
+                "must be a number in (0, 1] (typically 0.3), or absent for no ambiguity test",
             ));
         }
         if let Some(gate) = self.max_displacement_px
@@ -158,6 +176,13 @@ mod tests {
                 "vote_search_px",
                 PtvParams {
                     vote_search_px: Some(f64::INFINITY),
+                    ..Default::default()
+                },
+            ),
+            (
+                "ambiguity_ratio",
+                PtvParams {
+                    ambiguity_ratio: Some(1.5),
                     ..Default::default()
                 },
             ),

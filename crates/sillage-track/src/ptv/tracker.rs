@@ -89,6 +89,7 @@ pub struct PtvTracker {
     displacements: Vec<Vec2>,
     voted: Vec<Vec2>,
     forward: Vec<Option<Neighbour>>,
+    two_nearest: Vec<Vec<Neighbour>>,
     backward: Vec<Option<Neighbour>>,
     link12: Vec<Option<usize>>,
     link21: Vec<Option<usize>>,
@@ -128,6 +129,7 @@ impl PtvTracker {
             displacements: Vec::new(),
             voted: Vec::new(),
             forward: Vec::new(),
+            two_nearest: Vec::new(),
             backward: Vec::new(),
             link12: Vec::new(),
             link21: Vec::new(),
@@ -266,18 +268,34 @@ impl PtvTracker {
         } else {
             &self.index_c1
         };
-        self.index_c2.nearest_batch(&self.pred, &mut self.forward);
+        if self.params.ambiguity_ratio.is_some() {
+            self.index_c2
+                .k_nearest_batch(&self.pred, 2, &mut self.two_nearest);
+            self.forward.clear();
+            self.forward
+                .extend(self.two_nearest.iter().map(|n| n.first().copied()));
+        } else {
+            self.index_c2.nearest_batch(&self.pred, &mut self.forward);
+        }
         pred_index.nearest_batch(&self.c2, &mut self.backward);
         mutual_pairs(&self.forward, &self.backward, None, &mut self.link12);
         mutual_pairs(&self.backward, &self.forward, None, &mut self.link21);
+        if let Some(ratio) = self.params.ambiguity_ratio {
+            let two = &self.two_nearest;
+            retain_links(
+                &mut self.link12,
+                &mut self.link21,
+                |j, _| match two[j][..] {
+                    [(_, d1), (_, d2)] => d1 <= ratio * d2,
+                    _ => true,
+                },
+            );
+        }
         if let Some(gate) = self.params.max_displacement_px {
             let (c1, c2) = (&self.c1, &self.c2);
-            for (j, link) in self.link12.iter_mut().enumerate() {
-                *link = link.filter(|&k| c1[j].distance(c2[k]) <= gate);
-            }
-            for (k, link) in self.link21.iter_mut().enumerate() {
-                *link = link.filter(|&j| c1[j].distance(c2[k]) <= gate);
-            }
+            retain_links(&mut self.link12, &mut self.link21, |j, k| {
+                c1[j].distance(c2[k]) <= gate
+            });
         }
     }
 
@@ -364,6 +382,22 @@ impl PtvTracker {
         std::mem::swap(&mut self.link01, &mut self.link21);
         std::mem::swap(&mut self.ids0, &mut self.ids1);
         self.frame_c1 = frame;
+    }
+}
+
+/// Drops the mutual links `j ↔ k` (kept in both directions) for which `keep(j, k)` is false.
+fn retain_links(
+    link12: &mut [Option<usize>],
+    link21: &mut [Option<usize>],
+    keep: impl Fn(usize, usize) -> bool,
+) {
+    for (j, link) in link12.iter_mut().enumerate() {
+        if let Some(k) = *link
+            && !keep(j, k)
+        {
+            *link = None;
+            link21[k] = None;
+        }
     }
 }
 
