@@ -75,7 +75,9 @@ fn fast_vortex_with_displacement_voting_meets_the_p_inverse_claim() {
     let mut config = PipelineConfig::default();
     config.set("tracker.vote_search_px=100").expect("known key");
     let voting = vortex_accuracy(&params, &config);
-    config.set("tracker.ambiguity_ratio=0.5").expect("known key");
+    config
+        .set("tracker.ambiguity_ratio=0.5")
+        .expect("known key");
     let voting_ratio = vortex_accuracy(&params, &config);
     eprintln!(
         "TracTrac's predictor:\n{tractrac}\nwith displacement voting:\n{voting}\n\
@@ -104,7 +106,9 @@ fn intermittent_vortex_with_the_ambiguity_test_meets_the_papers_figure() {
     };
     let tractrac = vortex_accuracy(&params, &PipelineConfig::default());
     let mut config = PipelineConfig::default();
-    config.set("tracker.ambiguity_ratio=0.3").expect("known key");
+    config
+        .set("tracker.ambiguity_ratio=0.3")
+        .expect("known key");
     let ratio = vortex_accuracy(&params, &config);
     eprintln!("TracTrac's filter:\n{tractrac}\nwith the ambiguity test:\n{ratio}");
     assert!(tractrac.false_recovery_rate.unwrap() > 0.3);
