@@ -58,6 +58,42 @@ impl Default for TrackerConfig {
 /// Largest number of training passes accepted (each is a full tracking run).
 const MAX_TRAINING_PASSES: usize = 20;
 
+/// The optional keys (absent by default, so missing from the TOML output): key, an example
+/// value, and what setting it does.
+pub const OPTIONAL_KEYS: [(&str, &str, &str); 7] = [
+    (
+        "mask",
+        "\"mask.png\"",
+        "image whose black pixels are ignored",
+    ),
+    ("preprocess.median", "3", "median filter of 3×3 or 5×5 px"),
+    (
+        "preprocess.background.speed",
+        "0.01",
+        "subtract a slowly adapting background",
+    ),
+    (
+        "detector.roi",
+        "{ x0 = 0, y0 = 0, x1 = 512, y1 = 512 }",
+        "region of interest, px",
+    ),
+    (
+        "tracker.vote_search_px",
+        "100",
+        "displacement voting for fast flows: largest displacement, px",
+    ),
+    (
+        "tracker.ambiguity_ratio",
+        "0.3",
+        "drop links whose nearest candidate is not clearly nearer than the second",
+    ),
+    (
+        "tracker.max_displacement_px",
+        "20",
+        "reject links longer than this, px",
+    ),
+];
+
 impl PipelineConfig {
     /// Reads a TOML configuration file.
     pub fn from_toml_file(path: &Path) -> Result<Self> {
@@ -79,9 +115,16 @@ impl PipelineConfig {
     }
 
     /// The configuration as TOML text (what `sillage config` prints).
+    /// Unset optional keys do not appear in TOML, so they are listed after it as comments
+    /// ([`OPTIONAL_KEYS`]): every parameter can be found in the output.
     pub fn to_toml_string(&self) -> Result<String> {
-        toml::to_string_pretty(self)
-            .map_err(|e| Error::input(format!("cannot serialise the configuration: {e}")))
+        let mut text = toml::to_string_pretty(self)
+            .map_err(|e| Error::input(format!("cannot serialise the configuration: {e}")))?;
+        text.push_str("\n# Optional keys, off unless set (`--set KEY=VALUE` or in this file):\n");
+        for (key, example, meaning) in OPTIONAL_KEYS {
+            text.push_str(&format!("# {key} = {example}  # {meaning}\n"));
+        }
+        Ok(text)
     }
 
     /// Applies one `key=value` override, `key` being a dotted path such as
@@ -235,6 +278,14 @@ mod tests {
         let mut config = PipelineConfig::default();
         config.set("training_passes=2").unwrap();
         let text = config.to_toml_string().unwrap();
+        for (key, example, _) in OPTIONAL_KEYS {
+            let mut with_key = PipelineConfig::default();
+            with_key
+                .set(&format!("{key}={example}"))
+                .unwrap_or_else(|e| panic!("{key}: {e}"));
+            assert_ne!(with_key, PipelineConfig::default(), "{key} changed nothing");
+            assert!(text.contains(&format!("# {key} = ")), "{key} not listed");
+        }
         assert_eq!(PipelineConfig::from_toml_str(&text).unwrap(), config);
         let err = PipelineConfig::from_toml_str("[tracker]\nkind = \"ptv\"\nmotion_avg = 3\n")
             .unwrap_err()
