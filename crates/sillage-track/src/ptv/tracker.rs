@@ -11,6 +11,15 @@ use super::motion::{MotionField, Samples};
 use super::params::PtvParams;
 use super::voting::voted_displacements;
 
+/// Voted corrections shorter than this share of the mean spacing between points are left
+/// out: too small to change a nearest neighbour, they would only replace the model's own
+/// prediction by the coarser voted one. Measured: taking every correction costs 2 points of
+/// true recoveries on the paper's slow vortex; from 1/32 of the spacing on, the slow vortex
+/// is tracked exactly as without voting. Larger shares help the moderately fast vortex
+/// (δ = 0.05: 88.2 % at 1/32, 88.9 % at 1/16, 90.6 % at 1/8) but hurt a fast solid rotation,
+/// whose centripetal lag they leave uncorrected (recall 0.883, 0.866, 0.844).
+const VOTE_MIN_CORRECTION_SPACINGS: f64 = 0.0625;
+
 /// Direction of a pass over the sequence (TracTrac's `vid_loop` alternates them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PassDirection {
@@ -230,7 +239,8 @@ impl PtvTracker {
     }
 
     /// Displacement voting (`vote_search_px`): replaces the predicted velocities by the
-    /// displacement voted within `search_px` of them. Without a model (`model_applied`
+    /// displacement voted within `search_px` of them, where the two differ by more than
+    /// [`VOTE_MIN_CORRECTION_SPACINGS`] of the spacing. Without a model (`model_applied`
     /// false) the vote starts from zero motion and its result is also stored as the model,
     /// so that the next frame is predicted from it.
     fn correct_by_voting(&mut self, model_applied: bool, search_px: f64, dt: f64) {
@@ -238,20 +248,28 @@ impl PtvTracker {
         self.displacements
             .extend(self.vel_pred.iter().map(|&u| u * dt));
         let mut voted = std::mem::take(&mut self.voted);
-        if let Some(resolution_px) = voted_displacements(
+        if let Some(vote) = voted_displacements(
             &self.c1,
             &self.c2,
             Some(&self.displacements),
             search_px,
             &mut voted,
         ) {
-            for (u, &d) in self.vel_pred.iter_mut().zip(&voted) {
-                *u = d / dt;
+            let min_correction_px = VOTE_MIN_CORRECTION_SPACINGS * vote.spacing_px;
+            for ((u, &d), &prior) in self
+                .vel_pred
+                .iter_mut()
+                .zip(&voted)
+                .zip(&self.displacements)
+            {
+                if !model_applied || (d - prior).norm() > min_correction_px {
+                    *u = d / dt;
+                }
             }
             if !model_applied {
                 self.stored.clear();
                 for (&p, &u) in self.c1.iter().zip(&self.vel_pred) {
-                    self.stored.push(p, u, resolution_px.log10());
+                    self.stored.push(p, u, vote.resolution_px.log10());
                 }
             }
         }

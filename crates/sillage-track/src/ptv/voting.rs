@@ -37,8 +37,17 @@ const MEDIAN_TEST_FLOOR_BINS: f64 = 0.1;
 const PEAK_SIGMAS: f64 = 4.0;
 const MIN_PEAK_VOTES: f64 = 3.0;
 
+/// What a vote found besides the displacements.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Vote {
+    /// The last histogram bin, px: the resolution of the voted displacements.
+    pub resolution_px: f64,
+    /// Mean spacing between the points of `a`, `√(area / n)`, px.
+    pub spacing_px: f64,
+}
+
 /// The displacement from frame `a` to frame `b` at each point of `a`, written to `out`
-/// (same order as `a`), and its resolution (the last histogram bin, px); `None` (and `out`
+/// (same order as `a`), and what the vote found ([`Vote`]); `None` (and `out`
 /// left empty) when no cell found a significant displacement. `prior` (per point of `a`,
 /// zero when `None`) is the first guess and `search_px` the largest error of it searched.
 pub(crate) fn voted_displacements(
@@ -47,13 +56,14 @@ pub(crate) fn voted_displacements(
     prior: Option<&[Vec2]>,
     search_px: f64,
     out: &mut Vec<Vec2>,
-) -> Option<f64> {
+) -> Option<Vote> {
     out.clear();
     if a.is_empty() || b.is_empty() {
         return None;
     }
     let extent = Extent::covering(a.iter().chain(b));
-    let cell = (extent.area() * POINTS_PER_CELL / a.len() as f64).sqrt();
+    let spacing_px = (extent.area() / a.len() as f64).sqrt();
+    let cell = spacing_px * POINTS_PER_CELL.sqrt();
     let bin = (search_px / BINS_PER_RADIUS).max(MIN_BIN_PX);
     let coarse_grid = Grid::new(&extent, cell);
     let zero;
@@ -80,11 +90,17 @@ pub(crate) fn voted_displacements(
                     .zip(&refined)
                     .map(|(&p, &d)| d + fine_grid.interpolate(&fine, p)),
             );
-            Some(fine_bin)
+            Some(Vote {
+                resolution_px: fine_bin,
+                spacing_px,
+            })
         }
         None => {
             out.extend_from_slice(&refined);
-            Some(bin)
+            Some(Vote {
+                resolution_px: bin,
+                spacing_px,
+            })
         }
     }
 }
