@@ -6,8 +6,9 @@ use std::fs::File;
 use std::path::Path;
 use std::sync::Arc;
 
-use arrow::array::{Array, ArrayRef, AsArray, Float64Array, Int64Array, RecordBatch};
-use arrow::datatypes::{DataType, Field, Float64Type, Int64Type, Schema, SchemaRef};
+use arrow_array::types::{Float64Type, Int64Type};
+use arrow_array::{Array, ArrayRef, Float64Array, Int64Array, RecordBatch, cast::AsArray};
+use arrow_schema::{DataType, Field, Schema, SchemaRef};
 use parquet::arrow::ArrowWriter;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use parquet::basic::{Compression, ZstdLevel};
@@ -162,7 +163,7 @@ pub(crate) fn read_parquet(path: &Path) -> Result<Vec<TrackPoint>> {
         let column = |name: &str, ty: &DataType| -> Result<Option<ArrayRef>> {
             batch
                 .column_by_name(name)
-                .map(|c| arrow::compute::cast(c, ty))
+                .map(|c| arrow_cast::cast(c, ty))
                 .transpose()
                 .map_err(|e| {
                     Error::format(
