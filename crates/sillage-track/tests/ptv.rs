@@ -346,22 +346,29 @@ fn output_does_not_depend_on_the_number_of_threads() {
 #[test]
 fn empty_and_single_point_frames_do_not_panic() {
     let sizes = [0usize, 1, 0, 1, 1, 2, 0, 0, 3, 1, 1, 1];
-    let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
-    let mut out = Vec::new();
-    for (f, &n) in sizes.iter().enumerate() {
-        let dets: Vec<Detection> = (0..n)
-            .map(|i| Detection::new(Point2::new(10.0 * i as f64 + f as f64, 5.0), 1.0))
-            .collect();
-        tracker
-            .step(
-                &FrameObservations::from_detections(f as u64, &dets),
-                &mut out,
-            )
-            .unwrap();
+    let with_additions = PtvParams {
+        vote_search_px: Some(30.0),
+        ambiguity_ratio: Some(0.5),
+        ..Default::default()
+    };
+    for params in [PtvParams::default(), with_additions] {
+        let mut tracker = PtvTracker::new(params).unwrap();
+        let mut out = Vec::new();
+        for (f, &n) in sizes.iter().enumerate() {
+            let dets: Vec<Detection> = (0..n)
+                .map(|i| Detection::new(Point2::new(10.0 * i as f64 + f as f64, 5.0), 1.0))
+                .collect();
+            tracker
+                .step(
+                    &FrameObservations::from_detections(f as u64, &dets),
+                    &mut out,
+                )
+                .unwrap();
+        }
+        tracker.finish(&mut out).unwrap();
+        // Only frames with a point before and after can be the middle of a triplet.
+        assert!(out.iter().all(|p| p.frame == 4 || p.frame >= 9), "{out:?}");
     }
-    tracker.finish(&mut out).unwrap();
-    // Only frames with a point before and after can be the middle of a triplet.
-    assert!(out.iter().all(|p| p.frame == 4 || p.frame >= 9), "{out:?}");
 }
 
 #[test]
