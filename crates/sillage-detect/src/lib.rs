@@ -33,9 +33,11 @@
 //! # Ok::<(), sillage_core::Error>(())
 //! ```
 
+pub mod bead;
 pub mod blob;
 pub mod preprocess;
 
+pub use bead::{BeadDetections, BeadDetector, BeadGeometry, BeadParams};
 pub use blob::{BlobDetector, BlobFilter, BlobParams, DEFAULT_NOISE_K, Threshold};
 pub use preprocess::{BackgroundParams, PreprocessParams, Preprocessor};
 pub use sillage_image::{MedianSize, Polarity, Roi, SubpixelFit};

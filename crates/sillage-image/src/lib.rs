@@ -42,19 +42,31 @@
 
 pub mod background;
 pub mod bandpass;
+pub mod box_mean;
+pub mod components;
 pub mod gaussian;
 pub mod mask;
 pub mod maxima;
 pub mod median;
+pub mod morphology;
+pub mod ncc;
+pub mod reconstruct;
 mod separable;
 pub mod stats;
+pub mod structuring;
 pub mod subpixel;
 
 pub use background::BackgroundModel;
 pub use bandpass::{DogFilter, LogFilter, MAX_SCALE_PX, Polarity};
+pub use box_mean::box_mean_3x3;
+pub use components::{Component, ComponentLabeller};
 pub use gaussian::{GaussianFilter, GaussianKernel, MAX_SIGMA_PX};
 pub use mask::{Roi, apply_mask};
 pub use maxima::{Peak, PeakFinder};
 pub use median::{MedianSize, median_filter};
+pub use morphology::Morphology;
+pub use ncc::{MAX_TEMPLATE_RADIUS_PX, RingCorrelator, RingTemplate};
+pub use reconstruct::Reconstruction;
 pub use stats::{MeanStd, MedianMad, mean_std, median_mad};
+pub use structuring::{MAX_ELEMENT_RADIUS_PX, StructuringElement};
 pub use subpixel::{SubpixelFit, parabola_offset, refine_peak};

@@ -1,0 +1,178 @@
+//! Transparent beads (MMPF+ paper §3.3.1, BeadTracking's `DetectTransBeads`): black beads and
+//! the flume base erased into the background (a morphological closing), black top-hat,
+//! h-concave transform, normalised cross-correlation with the ring template, 3×3 mean
+//! smoothing, local maxima; maxima above τ_t are beads, maxima above the lower candidate
+//! threshold are the detector-confidence candidates of Eq. (1) (§3.3.2).
+
+use sillage_core::{Detection, GrayImage, Image, Point2, Result};
+use sillage_image::{
+    Morphology, Peak, PeakFinder, Reconstruction, RingCorrelator, RingTemplate, StructuringElement,
+    box_mean_3x3,
+};
+
+/// The thresholds and sizes of the transparent stage, all checked by
+/// [`crate::bead::BeadParams::validate`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct TransparentSettings {
+    pub(crate) background_radius_px: usize,
+    pub(crate) erase_radius_px: usize,
+    pub(crate) h: f32,
+    pub(crate) smoothing_passes: usize,
+    pub(crate) detection_threshold: f32,
+    pub(crate) candidate_threshold: f32,
+    /// Maxima on input pixels at or below this grey level are dropped (`None`: kept).
+    pub(crate) dark_level: Option<f32>,
+}
+
+/// The transparent-bead stage with its buffers.
+#[derive(Debug, Clone)]
+pub(crate) struct TransparentStage {
+    settings: TransparentSettings,
+    background: StructuringElement,
+    /// Rows `(dy, dx0, dx1)` (inclusive) of the disk erased around each black bead.
+    erase_runs: Vec<(isize, isize, isize)>,
+    morphology: Morphology,
+    reconstruction: Reconstruction,
+    correlator: RingCorrelator,
+    finder: PeakFinder,
+    closed: GrayImage,
+    top_hat: GrayImage,
+    concave: GrayImage,
+    correlation: GrayImage,
+    smoothed: GrayImage,
+    peaks: Vec<Peak>,
+}
+
+/// What one frame gives: transparent beads and confidence candidates.
+pub(crate) struct TransparentOutput<'a> {
+    pub(crate) beads: &'a mut Vec<Detection>,
+    pub(crate) candidates: &'a mut Vec<Detection>,
+}
+
+impl TransparentStage {
+    pub(crate) fn new(settings: TransparentSettings, template: RingTemplate) -> Result<Self> {
+        let erase_runs = row_runs(&StructuringElement::disk(settings.erase_radius_px)?.offsets());
+        Ok(Self {
+            settings,
+            background: StructuringElement::disk(settings.background_radius_px)?,
+            erase_runs,
+            morphology: Morphology::new(),
+            reconstruction: Reconstruction::new(),
+            correlator: RingCorrelator::new(template),
+            finder: PeakFinder::new(),
+            closed: GrayImage::default(),
+            top_hat: GrayImage::default(),
+            concave: GrayImage::default(),
+            correlation: GrayImage::default(),
+            smoothed: GrayImage::default(),
+            peaks: Vec::new(),
+        })
+    }
+
+    /// Correlates with `template` from now on.
+    pub(crate) fn set_template(&mut self, template: RingTemplate) {
+        self.correlator = RingCorrelator::new(template);
+    }
+
+    /// Appends the transparent beads and candidates of `frame`. `bright_base` is the frame
+    /// with the base pixels set to 1 (so the closing does not see the base as dark), `base`
+    /// the base mask and `black` the black beads found in it.
+    pub(crate) fn detect(
+        &mut self,
+        frame: &GrayImage,
+        bright_base: &GrayImage,
+        base: Option<&Image<bool>>,
+        black: &[Detection],
+        out: TransparentOutput<'_>,
+    ) -> Result<()> {
+        let s = self.settings;
+        self.morphology
+            .close(bright_base, &self.background, &mut self.closed);
+        self.erased_top_hat(frame, base, black);
+        self.reconstruction
+            .h_concave(&self.top_hat, s.h, &mut self.concave)?;
+        self.correlator.apply(&self.concave, &mut self.correlation);
+        for _ in 0..s.smoothing_passes {
+            box_mean_3x3(&self.correlation, &mut self.smoothed);
+            std::mem::swap(&mut self.correlation, &mut self.smoothed);
+        }
+        // PeakFinder keeps values strictly above its threshold; BeadTracking keeps `≥`, the
+        // same maxima but for exact ties.
+        self.finder
+            .find(&self.correlation, 1, s.candidate_threshold, &mut self.peaks);
+        for peak in &self.peaks {
+            let on_base = base.is_some_and(|b| b.get(peak.x, peak.y));
+            let dark = s
+                .dark_level
+                .is_some_and(|level| frame.get(peak.x, peak.y) <= level);
+            if on_base || dark {
+                continue;
+            }
+            let score = self.correlation.get(peak.x, peak.y);
+            let candidate = Detection::new(Point2::new(peak.x as f64, peak.y as f64), score);
+            out.candidates.push(candidate);
+            if score >= s.detection_threshold {
+                out.beads.push(candidate);
+            }
+        }
+        Ok(())
+    }
+
+    /// `top_hat = closed − frame` (the black top-hat: dark rings stand out), 0 on the base and
+    /// on a disk around each black bead: there the frame is replaced by the background, as
+    /// the paper erases black beads before looking for transparent ones.
+    fn erased_top_hat(
+        &mut self,
+        frame: &GrayImage,
+        base: Option<&Image<bool>>,
+        black: &[Detection],
+    ) {
+        let (width, height) = frame.dimensions();
+        self.top_hat.reshape(width, height);
+        for ((t, &c), &f) in self
+            .top_hat
+            .as_mut_slice()
+            .iter_mut()
+            .zip(self.closed.as_slice())
+            .zip(frame.as_slice())
+        {
+            *t = c - f;
+        }
+        if let Some(base) = base {
+            for (t, &b) in self.top_hat.as_mut_slice().iter_mut().zip(base.as_slice()) {
+                if b {
+                    *t = 0.0;
+                }
+            }
+        }
+        for bead in black {
+            let (cx, cy) = (
+                bead.pos_px.x.round() as isize,
+                bead.pos_px.y.round() as isize,
+            );
+            for &(dy, dx0, dx1) in &self.erase_runs {
+                let y = cy + dy;
+                if y < 0 || y >= height as isize {
+                    continue;
+                }
+                let x0 = (cx + dx0).max(0);
+                let x1 = (cx + dx1).min(width as isize - 1);
+                if x0 <= x1 {
+                    self.top_hat.row_mut(y as usize)[x0 as usize..=x1 as usize].fill(0.0);
+                }
+            }
+        }
+    }
+}
+
+/// Maximal horizontal runs `(dy, dx0, dx1)` (inclusive) of offsets sorted by row then column.
+fn row_runs(offsets: &[(isize, isize)]) -> Vec<(isize, isize, isize)> {
+    let mut runs: Vec<(isize, isize, isize)> = Vec::new();
+    for &(dx, dy) in offsets {
+        match runs.last_mut() {
+            Some(run) if run.0 == dy && run.2 + 1 == dx => run.2 = dx,
+            _ => runs.push((dy, dx, dx)),
+        }
+    }
+    runs
+}

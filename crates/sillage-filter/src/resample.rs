@@ -1,0 +1,234 @@
+//! Resampling: which particles survive, in proportion to their weights (§3.5.2 of the MMPF+
+//! paper, "normalizing and resampling").
+//!
+//! Every scheme is unbiased (particle `i` is drawn `N·wᵢ` times on average) and runs in O(N):
+//! the ordered positions in `[0, total)` are merged once with the running sum of the weights,
+//! so the ancestors come out sorted, which keeps the gather that follows cache-friendly.
+//! Schemes from Douc & Cappé 2005, "Comparison of resampling schemes for particle filtering".
+
+use rand::RngExt;
+use rand_distr::Exp1;
+use serde::{Deserialize, Serialize};
+use sillage_core::{Error, Result, RngStream};
+
+/// A resampling scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ResampleScheme {
+    /// N independent draws from the weights: the paper's choice (§3.5.2, "multinomial
+    /// resampling based on the bootstrap method"). Ordered uniforms come from normalised
+    /// cumulative exponential spacings, so no search is needed.
+    #[default]
+    Multinomial,
+    /// One uniform offset, then evenly spaced positions: the lowest variance, each count is
+    /// ⌊N·wᵢ⌋ or ⌈N·wᵢ⌉.
+    Systematic,
+    /// One uniform draw in each of the N strata `[k/N, (k+1)/N)`.
+    Stratified,
+    /// ⌊N·wᵢ⌋ copies of each particle, the remainder drawn multinomially from the residuals.
+    Residual,
+}
+
+/// When and how to resample: every step (the paper), or only when the effective sample size
+/// falls below a fraction of N (the ESS-triggered wrapper).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Resampling {
+    /// The scheme; default multinomial (§3.5.2).
+    pub scheme: ResampleScheme,
+    /// Resample only when `ESS < ess_fraction · N`, with `ess_fraction` in (0, 1]; absent
+    /// (the default, the paper's behaviour) resamples at every step.
+    pub ess_fraction: Option<f64>,
+}
+
+impl Resampling {
+    /// Checks `ess_fraction`; the error names the key.
+    pub fn validate(&self) -> Result<()> {
+        if let Some(fraction) = self.ess_fraction
+            && !(fraction > 0.0 && fraction <= 1.0)
+        {
+            return Err(Error::parameter(
+                "resampling.ess_fraction",
+                fraction,
+                "must be a number in (0, 1] (0.5 is common), or absent to resample at every \
+                 step as the paper does",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Whether a set of `n` particles with effective sample size `ess` is resampled.
+    pub fn triggers(&self, ess: f64, n: usize) -> bool {
+        match self.ess_fraction {
+            None => true,
+            Some(fraction) => ess < fraction * n as f64,
+        }
+    }
+}
+
+/// Draws ancestor indices; owns its buffers so that a filter reuses them at every step.
+#[derive(Debug, Clone, Default)]
+pub struct Resampler {
+    ancestors: Vec<u32>,
+    positions: Vec<f64>,
+    cumulative: Vec<f64>,
+}
+
+impl Resampler {
+    /// `weights.len()` ancestor indices drawn by `scheme` from `weights` (non-negative, any
+    /// positive sum; they are overwritten by the residual scheme). A set whose sum is not a
+    /// positive finite number is treated as uniform. Indices are < 2³².
+    pub fn draw(
+        &mut self,
+        scheme: ResampleScheme,
+        weights: &mut [f64],
+        rng: &mut RngStream,
+    ) -> &[u32] {
+        let n = weights.len();
+        self.ancestors.clear();
+        self.positions.clear();
+        if n == 0 {
+            return &self.ancestors;
+        }
+        let mut total: f64 = weights.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            weights.fill(1.0);
+            total = n as f64;
+        }
+        let step = total / n as f64;
+        match scheme {
+            ResampleScheme::Multinomial => self.multinomial_positions(total, n, rng),
+            ResampleScheme::Systematic => {
+                let offset: f64 = rng.random();
+                let positions = (0..n).map(|k| (k as f64 + offset) * step);
+                self.positions.extend(positions);
+            }
+            ResampleScheme::Stratified => {
+                let positions = (0..n).map(|k| (k as f64 + rng.random::<f64>()) * step);
+                self.positions.extend(positions);
+            }
+            ResampleScheme::Residual => {
+                let scale = 1.0 / step;
+                for (i, w) in weights.iter_mut().enumerate() {
+                    let expected = *w * scale;
+                    let copies = expected.floor();
+                    self.ancestors
+                        .extend(std::iter::repeat_n(i as u32, copies as usize));
+                    *w = expected - copies;
+                }
+                // Rounding can make the copies overshoot n by one.
+                self.ancestors.truncate(n);
+                let rest = n - self.ancestors.len();
+                let residual_total: f64 = weights.iter().sum();
+                if rest > 0 && residual_total > 0.0 {
+                    self.multinomial_positions(residual_total, rest, rng);
+                }
+            }
+        }
+        merge(
+            weights,
+            &self.positions,
+            &mut self.cumulative,
+            &mut self.ancestors,
+        );
+        // A draw left with no residual mass by rounding: keep exactly n ancestors.
+        while self.ancestors.len() < n {
+            let last = self.ancestors.last().copied().unwrap_or(0);
+            self.ancestors.push(last);
+        }
+        &self.ancestors
+    }
+
+    /// `count` ordered multinomial positions in `[0, total)`: ordered uniforms `Sₖ / S_{count+1}`
+    /// from cumulative standard exponentials (Devroye 1986, §V.3), so no search is needed
+    /// afterwards. (Measured faster here than inverting unsorted uniforms through a guide
+    /// table.)
+    fn multinomial_positions(&mut self, total: f64, count: usize, rng: &mut RngStream) {
+        let mut cumulative = 0.0;
+        for _ in 0..count {
+            cumulative += rng.sample::<f64, _>(Exp1);
+            self.positions.push(cumulative);
+        }
+        let end = cumulative + rng.sample::<f64, _>(Exp1);
+        let scale = total / end;
+        self.positions.iter_mut().for_each(|p| *p *= scale);
+    }
+}
+
+/// Appends, for each of the non-decreasing `positions` in `[0, Σw)`, the index whose
+/// cumulative-weight interval holds it. Zero-weight particles are never chosen, even when
+/// rounding pushes a position past the last cumulative sum.
+///
+/// Branch-free: each step either emits an ancestor or moves to the next weight, chosen by a
+/// comparison turned into an increment. On the peaked weights a likelihood leaves, the usual
+/// nested loop mispredicts about once per particle; this form measured ~20 % faster.
+fn merge(weights: &[f64], positions: &[f64], cumulative: &mut Vec<f64>, out: &mut Vec<u32>) {
+    let Some(last_positive) = weights.iter().rposition(|&w| w > 0.0) else {
+        return;
+    };
+    cumulative.clear();
+    let mut running = 0.0;
+    cumulative.extend(weights[..=last_positive].iter().map(|w| {
+        running += w;
+        running
+    }));
+    let start = out.len();
+    out.resize(start + positions.len(), 0);
+    let out = &mut out[start..];
+    let (mut j, mut k) = (0, 0);
+    while k < positions.len() {
+        let advance = (cumulative[j] <= positions[k]) & (j < last_positive);
+        out[k] = j as u32;
+        j += usize::from(advance);
+        k += usize::from(!advance);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sillage_core::rng_stream;
+
+    #[test]
+    fn zero_weights_are_never_drawn_and_counts_are_complete() {
+        let mut rng = rng_stream(1, 2);
+        let mut resampler = Resampler::default();
+        for scheme in [
+            ResampleScheme::Multinomial,
+            ResampleScheme::Systematic,
+            ResampleScheme::Stratified,
+            ResampleScheme::Residual,
+        ] {
+            for _ in 0..200 {
+                let mut w = [0.0, 0.5, 0.0, 0.25, 0.25, 0.0];
+                let drawn = resampler.draw(scheme, &mut w, &mut rng);
+                assert_eq!(drawn.len(), 6);
+                assert!(drawn.iter().all(|&i| [1, 3, 4].contains(&i)), "{scheme:?}");
+            }
+            // A degenerate set is treated as uniform rather than refused.
+            let mut w = [0.0; 3];
+            assert_eq!(resampler.draw(scheme, &mut w, &mut rng).len(), 3);
+        }
+    }
+
+    #[test]
+    fn ess_trigger() {
+        let always = Resampling::default();
+        assert!(always.triggers(100.0, 100));
+        let half = Resampling {
+            ess_fraction: Some(0.5),
+            ..Default::default()
+        };
+        assert!(half.triggers(49.9, 100) && !half.triggers(50.0, 100));
+        let bad = Resampling {
+            ess_fraction: Some(1.5),
+            ..Default::default()
+        };
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("`resampling.ess_fraction`")
+        );
+    }
+}
