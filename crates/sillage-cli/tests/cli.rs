@@ -3,25 +3,13 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
+
+mod common;
+use common::{path_str, sillage, stderr};
 
 use sillage_core::Point2;
 use sillage_synth::{Noise, NoiseKind, render_spots};
-
-fn sillage(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sillage"))
-        .args(args)
-        .output()
-        .expect("the sillage binary runs")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn path_str(path: &Path) -> &str {
-    path.to_str().expect("utf-8 temp path")
-}
 
 /// Writes `n` 16-bit TIFF frames of spots drifting right by 1.5 px per frame.
 fn write_tiff_frames(dir: &Path, n: usize, width: usize, height: usize) -> Vec<PathBuf> {

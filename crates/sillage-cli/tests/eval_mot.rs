@@ -5,26 +5,13 @@
 
 use std::fs;
 use std::path::Path;
-use std::process::{Command, Output};
+
+mod common;
+use common::{path_str, sillage, stderr};
 
 use serde_json::Value;
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
-
-fn sillage(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sillage"))
-        .args(args)
-        .output()
-        .expect("the sillage binary runs")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn path_str(path: &Path) -> &str {
-    path.to_str().expect("utf-8 path")
-}
 
 /// Runs `eval mot` with `args` and `--json`, and parses what it prints.
 fn eval_json(args: &[&str]) -> Value {
