@@ -32,6 +32,9 @@ pub use calibration::Calibration;
 pub use error::{Error, Result};
 pub use geometry::{Point2, Vec2};
 pub use image::{GrayImage, Image};
-pub use observation::{Detection, FrameIndex, MotionState, TrackId, TrackPoint, TruthPoint};
+pub use observation::{
+    BLACK_BEAD_CLASS, Detection, FrameIndex, MotionState, ObjectClass, TRANSPARENT_BEAD_CLASS,
+    TrackId, TrackPoint, TruthPoint,
+};
 pub use rng::{RngStream, rng_stream};
 pub use roles::{Detector, DiscardSink, FrameObservations, TrackSink, Tracker};

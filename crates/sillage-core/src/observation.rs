@@ -17,12 +17,36 @@ pub struct Detection {
     pub pos_px: Point2,
     /// Detector response at the centre (filtered intensity, NCC score, ...): larger is surer.
     pub strength: f32,
+    /// Object class (bead category: 0 black, 1 transparent; MOTChallenge class), 0 where a
+    /// detector knows one kind only. Trackers associate only within a class.
+    #[serde(default)]
+    pub class: ObjectClass,
 }
 
+/// Class of an object, as a small integer (see [`Detection::class`]).
+pub type ObjectClass = u32;
+
+/// Class of the black (coarse, 6 mm) beads of the bedload experiments: BeadTracking's
+/// category 0.
+pub const BLACK_BEAD_CLASS: ObjectClass = 0;
+
+/// Class of the transparent (fine, 4 mm) beads of the bedload experiments: BeadTracking's
+/// category 1.
+pub const TRANSPARENT_BEAD_CLASS: ObjectClass = 1;
+
 impl Detection {
-    /// A detection at `pos_px` with response `strength`.
+    /// A detection of class 0 at `pos_px` with response `strength`.
     pub const fn new(pos_px: Point2, strength: f32) -> Self {
-        Self { pos_px, strength }
+        Self::of_class(pos_px, strength, 0)
+    }
+
+    /// A detection of class `class` at `pos_px` with response `strength`.
+    pub const fn of_class(pos_px: Point2, strength: f32, class: ObjectClass) -> Self {
+        Self {
+            pos_px,
+            strength,
+            class,
+        }
     }
 }
 
@@ -62,6 +86,13 @@ pub struct TrackPoint {
     pub log10_pred_err: Option<f64>,
     /// Estimated motion state.
     pub motion_state: MotionState,
+    /// Object class, as the detections it was built from (0 where there is one kind only).
+    #[serde(default)]
+    pub class: ObjectClass,
+    /// Spread of the estimate, px: the root of the mean of the position covariance's two
+    /// variances (particle filters: the weighted particle spread; Kalman: the posterior).
+    #[serde(default)]
+    pub spread_px: Option<f64>,
 }
 
 impl TrackPoint {
@@ -76,6 +107,8 @@ impl TrackPoint {
             vel_pred_px_per_frame: None,
             log10_pred_err: None,
             motion_state: MotionState::Unknown,
+            class: 0,
+            spread_px: None,
         }
     }
 }

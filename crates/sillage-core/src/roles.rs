@@ -17,8 +17,11 @@ pub struct FrameObservations<'a> {
     pub detections: &'a [Detection],
     /// The pre-processed frame, for trackers that weigh particles against pixels.
     pub image: Option<&'a GrayImage>,
-    /// A detector-confidence map (MMPF+), when the detector makes one.
-    pub confidence: Option<&'a GrayImage>,
+    /// The detector-confidence candidates of Eq. (1) of the MMPF+ paper: every response
+    /// maximum above a low threshold, detections included, with its likelihood `L(d)` as
+    /// `strength` and its class; empty when the detector makes none. A tracker evaluates the
+    /// confidence density from them where it needs it (at particles), never as a full map.
+    pub candidates: &'a [Detection],
 }
 
 impl<'a> FrameObservations<'a> {
@@ -28,7 +31,7 @@ impl<'a> FrameObservations<'a> {
             frame,
             detections,
             image: None,
-            confidence: None,
+            candidates: &[],
         }
     }
 }

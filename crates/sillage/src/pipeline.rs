@@ -268,7 +268,7 @@ impl Pipeline {
             frame: index,
             detections: &self.detections,
             image,
-            confidence: None,
+            candidates: &[],
         };
         self.tracker.as_tracker().step(&observations, sink)?;
         Ok(FrameReport {

@@ -2,7 +2,7 @@
 //! τ_b, eroded so that touching beads separate, 8-connected components of a plausible area,
 //! their centroids.
 
-use sillage_core::{Detection, GrayImage, Image, Result};
+use sillage_core::{BLACK_BEAD_CLASS, Detection, GrayImage, Image, Result};
 use sillage_image::{Component, ComponentLabeller, Morphology, StructuringElement};
 
 /// The black-bead stage with its buffers.
@@ -62,7 +62,7 @@ impl BlackStage {
             self.components
                 .iter()
                 .filter(|c| (min_area..=max_area).contains(&(c.area as f64)))
-                .map(|c| Detection::new(c.centroid, 1.0)),
+                .map(|c| Detection::of_class(c.centroid, 1.0, BLACK_BEAD_CLASS)),
         );
     }
 }

@@ -4,7 +4,7 @@
 //! smoothing, local maxima; maxima above τ_t are beads, maxima above the lower candidate
 //! threshold are the detector-confidence candidates of Eq. (1) (§3.3.2).
 
-use sillage_core::{Detection, GrayImage, Image, Point2, Result};
+use sillage_core::{Detection, GrayImage, Image, Point2, Result, TRANSPARENT_BEAD_CLASS};
 use sillage_image::{
     Morphology, Peak, PeakFinder, Reconstruction, RingCorrelator, RingTemplate, StructuringElement,
     box_mean_3x3,
@@ -109,7 +109,8 @@ impl TransparentStage {
                 continue;
             }
             let score = self.correlation.get(peak.x, peak.y);
-            let candidate = Detection::new(Point2::new(peak.x as f64, peak.y as f64), score);
+            let pos_px = Point2::new(peak.x as f64, peak.y as f64);
+            let candidate = Detection::of_class(pos_px, score, TRANSPARENT_BEAD_CLASS);
             out.candidates.push(candidate);
             if score >= s.detection_threshold {
                 out.beads.push(candidate);

@@ -2,8 +2,8 @@
 
 use sillage_assoc::{Neighbour, NeighbourIndex, PointIndex, mutual_pairs};
 use sillage_core::{
-    Error, FrameIndex, FrameObservations, MotionState, Point2, Result, TrackId, TrackPoint,
-    TrackSink, Tracker, Vec2,
+    Error, FrameIndex, FrameObservations, Point2, Result, TrackId, TrackPoint, TrackSink, Tracker,
+    Vec2,
 };
 
 use super::filter::{INITIAL_THRESHOLD, log10_error, updated_threshold};
@@ -373,14 +373,11 @@ impl PtvTracker {
             self.ids1[t.middle] = id;
             if let (Some(track_id), true) = (id, t.kept) {
                 self.emitted.push(TrackPoint {
-                    frame: self.frame_c1,
-                    track_id,
-                    pos_px: self.c1[t.middle],
                     vel_px_per_frame: Some(t.vel),
                     acc_px_per_frame2: Some(t.acc),
                     vel_pred_px_per_frame: Some(self.vel_pred[t.middle]),
                     log10_pred_err: Some(t.log_err),
-                    motion_state: MotionState::Unknown,
+                    ..TrackPoint::at(self.frame_c1, track_id, self.c1[t.middle])
                 });
             }
         }
