@@ -28,6 +28,7 @@ pub use sillage_assoc as assoc;
 pub use sillage_core as core;
 pub use sillage_detect as detect;
 pub use sillage_eval as eval;
+pub use sillage_filter as filter;
 pub use sillage_image as image;
 pub use sillage_io as io;
 pub use sillage_synth as synth;
