@@ -396,6 +396,21 @@ impl PointIndex {
         best.n
     }
 
+    /// Calls `f(index, squared distance)` for every point within `radius` of `p` (distance
+    /// ≤ `radius`; none for a non-finite `p` or a negative or NaN `radius`), in an order fixed
+    /// by the indexed set: gating (association search regions, contacts, truncated kernels).
+    pub fn for_each_within(&self, p: Point2, radius: f64, f: impl FnMut(usize, f64)) {
+        if radius >= 0.0 {
+            let mut within = Within {
+                px: p.x,
+                py: p.y,
+                r2: radius * radius,
+                f,
+            };
+            self.search(p, &mut within);
+        }
+    }
+
     /// For every query, `f` of the indexes of its `min(k, len)` nearest points, nearest
     /// first (ties to the lower index), in parallel; `out[i]` answers `queries[i]`. Same
     /// neighbours as [`NeighbourIndex::k_nearest`], without the distances and without any
@@ -468,6 +483,32 @@ impl Visitor for Nearest {
     #[inline]
     fn worst_d2(&self) -> f64 {
         self.d2
+    }
+}
+
+/// Hands every point within a fixed squared distance to a callback.
+struct Within<F> {
+    px: f64,
+    py: f64,
+    r2: f64,
+    f: F,
+}
+
+impl<F: FnMut(usize, f64)> Visitor for Within<F> {
+    #[inline]
+    fn visit(&mut self, xs: &[f64], ys: &[f64], ids: &[u32]) {
+        for ((&x, &y), &id) in xs.iter().zip(ys).zip(ids) {
+            let (dx, dy) = (self.px - x, self.py - y);
+            let d = dx * dx + dy * dy;
+            if d <= self.r2 {
+                (self.f)(id as usize, d);
+            }
+        }
+    }
+
+    #[inline]
+    fn worst_d2(&self) -> f64 {
+        self.r2
     }
 }
 
@@ -599,6 +640,38 @@ mod tests {
         let index = PointIndex::new(&[Point2::new(f64::NAN, 0.0)]);
         assert_eq!(index.len(), 1);
         assert_eq!(index.nearest(Point2::new(0.0, 0.0)), None);
+    }
+
+    #[test]
+    fn radius_queries_match_brute_force() {
+        // A jittered lattice with repeated points, queried inside, on and outside the box.
+        let pts: Vec<_> = (0..400)
+            .map(|i| {
+                let j = (i * 7919 % 101) as f64 / 101.0;
+                Point2::new((i % 23) as f64 * 1.7 + j, (i / 23) as f64 * 2.3 - j)
+            })
+            .chain([Point2::new(5.0, 5.0); 3])
+            .collect();
+        let index = PointIndex::new(&pts);
+        for q in 0..200 {
+            let p = Point2::new(q as f64 * 0.31 - 8.0, (q * 37 % 60) as f64 - 5.0);
+            for radius in [0.0, 0.5, 2.0, 6.5, 100.0] {
+                let mut found = Vec::new();
+                index.for_each_within(p, radius, |i, d2| found.push((i, d2)));
+                found.sort_by_key(|&(i, _)| i);
+                let expected: Vec<_> = pts
+                    .iter()
+                    .enumerate()
+                    .map(|(i, x)| (i, (p.x - x.x).powi(2) + (p.y - x.y).powi(2)))
+                    .filter(|&(_, d2)| d2 <= radius * radius)
+                    .collect();
+                assert_eq!(found, expected, "query {p:?} radius {radius}");
+            }
+        }
+        let mut none = 0;
+        index.for_each_within(Point2::new(f64::NAN, 0.0), 10.0, |_, _| none += 1);
+        index.for_each_within(Point2::new(5.0, 5.0), -1.0, |_, _| none += 1);
+        assert_eq!(none, 0);
     }
 
     #[test]

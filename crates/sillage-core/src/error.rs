@@ -124,11 +124,40 @@ impl Error {
     pub fn input(message: impl Into<String>) -> Self {
         Error::Input(message.into())
     }
+
+    /// The same error with the key of a parameter error placed under `section`
+    /// (`particles` → `filter.particles`), so that a nested configuration's errors name the
+    /// key as the user writes it; other errors are unchanged.
+    pub fn in_section(self, section: &str) -> Self {
+        match self {
+            Error::Parameter {
+                key,
+                value,
+                message,
+            } => Error::Parameter {
+                key: format!("{section}.{key}"),
+                value,
+                message,
+            },
+            other => other,
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sections_prefix_parameter_keys_only() {
+        let e = Error::parameter("particles", 0, "must be ≥ 1").in_section("filter");
+        assert_eq!(
+            e.to_string(),
+            "parameter `filter.particles` = 0: must be ≥ 1"
+        );
+        let e = Error::input("empty").in_section("filter");
+        assert_eq!(e.to_string(), "empty");
+    }
 
     #[test]
     fn messages_name_file_line_and_key() {

@@ -56,6 +56,11 @@ impl Vec2 {
         self.x.hypot(self.y)
     }
 
+    /// Squared Euclidean norm (no square root: distances compared or put in a Gaussian).
+    pub fn norm_squared(self) -> f64 {
+        self.x * self.x + self.y * self.y
+    }
+
     /// Largest absolute component (Chebyshev norm), the norm TracTrac's error uses.
     pub fn max_abs(self) -> f64 {
         self.x.abs().max(self.y.abs())

@@ -54,6 +54,7 @@
 //! # }
 //! ```
 
+mod bead_tracks;
 mod beads;
 mod detections;
 mod frames;
@@ -65,6 +66,7 @@ mod tracks;
 mod tractrac_par;
 mod truth;
 
+pub use bead_tracks::{BEAD_TRACK_HEADER, BeadCsvWriter};
 pub use beads::{
     BEAD_HEADER, BeadCategory, BeadPoint, BeadSequenceParams, parse_bead_sequence_params,
     read_bead_csv, read_bead_sequence_params,

@@ -3,6 +3,8 @@
 //! - [`ptv`]: TracTrac-class particle tracking velocimetry — three-frame mutual
 //!   nearest-neighbour association with a local-flow motion model and an adaptive outlier
 //!   filter (Heyman, TracTrac, §3.1.2–3.1.4).
+//! - [`bedload`]: MMPF+, the multi-model particle filter of bedload beads, and the MMPF, PF,
+//!   Kalman IMM and deterministic baselines of its Table 1 (Lafaye de Micheaux et al. 2018).
 //!
 //! ```
 //! use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker};
@@ -26,4 +28,5 @@
 //! assert_eq!(points[0].track_id, points[2].track_id);
 //! ```
 
+pub mod bedload;
 pub mod ptv;
