@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use sillage_core::{Error, Result};
+
+use crate::toml_config::{parse_toml, read_toml_file, set_key};
 use sillage_detect::blob::BlobParams;
 use sillage_detect::preprocess::PreprocessParams;
 use sillage_track::ptv::PtvParams;
@@ -97,21 +99,12 @@ pub const OPTIONAL_KEYS: [(&str, &str, &str); 7] = [
 impl PipelineConfig {
     /// Reads a TOML configuration file.
     pub fn from_toml_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        Self::from_toml_str(&text).map_err(|e| match e {
-            Error::Input(message) => Error::format(path, None, message),
-            other => other,
-        })
+        read_toml_file(path)
     }
 
     /// Parses a TOML configuration.
     pub fn from_toml_str(text: &str) -> Result<Self> {
-        toml::from_str(text).map_err(|e| {
-            Error::input(format!(
-                "invalid configuration: {}; see `sillage config` for every key and its default",
-                e.message()
-            ))
-        })
+        parse_toml(text)
     }
 
     /// The configuration as TOML text (what `sillage config` prints).
@@ -131,46 +124,7 @@ impl PipelineConfig {
     /// `detector.scale_px` or `tracker.motion_av`; `value` is read as TOML (numbers, booleans,
     /// strings with or without quotes).
     pub fn set(&mut self, assignment: &str) -> Result<()> {
-        let (key, raw_value) = assignment.split_once('=').ok_or_else(|| {
-            Error::parameter(
-                assignment,
-                "",
-                "overrides look like `key=value`, e.g. `detector.scale_px=2.5`",
-            )
-        })?;
-        let key = key.trim();
-        let value = parse_toml_value(raw_value.trim());
-        let tree = toml::Value::try_from(&*self)
-            .map_err(|e| Error::input(format!("cannot serialise the configuration: {e}")))?;
-        // An enum is written as a one-key table (`threshold.auto.std_factor` vs
-        // `threshold.fixed`): when adding the key alone fails, choosing another variant is
-        // tried by emptying each enclosing section in turn, innermost first.
-        let depth = key.split('.').count();
-        let attempts = std::iter::once(None).chain((1..depth).rev().map(Some));
-        let mut first_error = None;
-        for clear_at in attempts {
-            let mut candidate = tree.clone();
-            insert_dotted(&mut candidate, key, value.clone(), clear_at)
-                .map_err(|message| Error::parameter(key, raw_value, message))?;
-            match candidate.try_into() {
-                Ok(config) => {
-                    *self = config;
-                    return Ok(());
-                }
-                Err(e) => {
-                    let e: toml::de::Error = e;
-                    first_error.get_or_insert(e);
-                }
-            }
-        }
-        let message = first_error
-            .map(|e| e.message().to_string())
-            .unwrap_or_default();
-        Err(Error::parameter(
-            key,
-            raw_value,
-            format!("{message}; see `sillage config` for every key"),
-        ))
+        set_key(self, assignment)
     }
 
     /// Checks every parameter once; the error names the key and its allowed range.
@@ -191,45 +145,6 @@ impl PipelineConfig {
         }
         Ok(())
     }
-}
-
-/// Reads `raw` as a TOML value; bare words that are not TOML become strings.
-fn parse_toml_value(raw: &str) -> toml::Value {
-    toml::from_str::<toml::Table>(&format!("v = {raw}"))
-        .ok()
-        .and_then(|mut table| table.remove("v"))
-        .unwrap_or_else(|| toml::Value::String(raw.to_string()))
-}
-
-/// Sets `tree[a][b]...[last] = value` for the dotted `key`, creating tables on the way; the
-/// table at depth `clear_at` (the one holding the `clear_at`-th segment) is emptied first.
-fn insert_dotted(
-    tree: &mut toml::Value,
-    key: &str,
-    value: toml::Value,
-    clear_at: Option<usize>,
-) -> std::result::Result<(), String> {
-    let mut node = tree;
-    let parts: Vec<&str> = key.split('.').collect();
-    for (depth, part) in parts.iter().enumerate() {
-        if part.is_empty() {
-            return Err("empty key segment; write keys like `tracker.motion_av`".into());
-        }
-        let table = node
-            .as_table_mut()
-            .ok_or_else(|| format!("`{}` is a value, not a section", parts[..depth].join(".")))?;
-        if clear_at == Some(depth) {
-            table.clear();
-        }
-        if depth + 1 == parts.len() {
-            table.insert((*part).to_string(), value);
-            return Ok(());
-        }
-        node = table
-            .entry((*part).to_string())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@
 
 pub mod config;
 pub mod pipeline;
+pub mod toml_config;
 pub mod tractrac;
 
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};

@@ -30,7 +30,7 @@ struct Pair {
 }
 
 /// The association of one frame (buffers reused frame to frame).
-#[derive(Debug, Default)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct GreedyAssociation {
     index: PointIndex,
     positions: Vec<Point2>,

@@ -35,7 +35,7 @@ impl StateRule {
 }
 
 /// The beads of one frame, indexed for contact counts (buffers reused frame to frame).
-#[derive(Debug, Default)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Contacts {
     positions: Vec<Point2>,
     classes: Vec<ObjectClass>,

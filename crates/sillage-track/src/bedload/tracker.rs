@@ -64,7 +64,7 @@ struct Track {
 /// Each frame's points are emitted at that frame's step; a tracker's first point is emitted
 /// when a second detection confirms it, so a batch may also hold points of the previous frame.
 /// The output is identical for any number of threads.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct BedloadTracker {
     settings: Settings,
     motion: ParticleMotion,
