@@ -5,6 +5,7 @@ use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use sillage::eval::mot::{MotChallengeProtocol, MotConvention, Similarity};
+use sillage::filter::FitOptions;
 
 /// Follow many moving objects through image sequences (PTV, bedload beads, pedestrians).
 #[derive(Debug, Parser)]
@@ -24,7 +25,9 @@ const EXAMPLES: &str = "Examples:
   sillage eval ptv --truth vortex/truth.csv --tracks tracks.csv
   sillage eval mot --gt MOT17/train --pred tracker/data --protocol mot17
   sillage eval mot --gt vortex/truth.csv --pred tracks.csv --match dist:1 --json
-  sillage bench ptv --particles 1000,5000,25000";
+  sillage bench ptv --particles 1000,5000,25000
+  sillage fit bedload --truth trackdatatruth.csv --out motion.toml
+  sillage track bedload --detections det.csv --candidates cand.csv --config motion.toml --out tracks.csv";
 
 /// The verbs.
 #[derive(Debug, Subcommand)]
@@ -44,6 +47,12 @@ pub enum Command {
     Bench(BenchCommand),
     /// Print the configuration (defaults, or the result of --config/--set/--tractrac-par) as TOML.
     Config(ConfigArgs),
+    /// Learn model parameters from ground truth and write them as a TOML config.
+    #[command(subcommand)]
+    Fit(FitCommand),
+    /// Track detections with one of the object trackers and write trajectories.
+    #[command(subcommand)]
+    Track(TrackCommand),
 }
 
 /// Where the configuration comes from; later sources override earlier ones.
@@ -376,6 +385,107 @@ pub struct BenchPtvArgs {
     #[arg(long, value_name = "FRAMES")]
     pub stream: Option<usize>,
     /// Print the table as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `sillage fit <kind>`.
+#[derive(Debug, Subcommand)]
+pub enum FitCommand {
+    /// The bedload particle filter's transition table (MMPF+ Eqs. (11)-(12)) and process noises
+    /// (Eq. (3)) from ground truth with motion states, trained on the first half (§4.3).
+    Bedload(FitBedloadArgs),
+}
+
+/// `sillage fit bedload`.
+#[derive(Debug, Args)]
+pub struct FitBedloadArgs {
+    /// Ground truth with motion states: a BeadTracking CSV
+    /// (frame,id,x,y,category,vx,vy,motion_state).
+    #[arg(long, value_name = "FILE")]
+    pub truth: PathBuf,
+    /// TOML file to write; its `[motion]` table holds the fitted parameters.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Share of the frame range to train on, from the first frame, in (0, 1].
+    #[arg(long, value_name = "F", default_value_t = FitOptions::default().train_fraction)]
+    pub train_fraction: f64,
+    /// Minimal transition probability imposed on each fitted row, in [0, 1/3]; 0 keeps the raw
+    /// estimate.
+    #[arg(long, value_name = "P", default_value_t = FitOptions::default().min_probability)]
+    pub min_probability: f64,
+    /// Fewest samples for a state's row or noises to be fitted; below, the default is kept.
+    #[arg(long, value_name = "N", default_value_t = FitOptions::default().min_samples)]
+    pub min_samples: u64,
+    /// Print the fitted parameters and the report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `sillage track <kind>`.
+#[derive(Debug, Subcommand)]
+pub enum TrackCommand {
+    /// Bedload beads: MMPF+ (default) or a baseline of its Table 1, from detections with
+    /// classes (0 black, 1 transparent); writes BeadTracking's CSV layout.
+    Bedload(TrackBedloadArgs),
+}
+
+/// The trackers of `sillage track bedload --tracker`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum BedloadTrackerArg {
+    /// Multi-model particle filter with the motion-state cue (the paper's method).
+    MmpfPlus,
+    /// Multi-model particle filter without the cue, one saltating state.
+    Mmpf,
+    /// One constant-velocity particle filter.
+    Pf,
+    /// Kalman IMM of the three linear motions.
+    Imm,
+    /// Deterministic association of the detections.
+    Det,
+}
+
+impl From<BedloadTrackerArg> for sillage::track::bedload::BedloadTrackerKind {
+    fn from(arg: BedloadTrackerArg) -> Self {
+        match arg {
+            BedloadTrackerArg::MmpfPlus => Self::MmpfPlus,
+            BedloadTrackerArg::Mmpf => Self::Mmpf,
+            BedloadTrackerArg::Pf => Self::Pf,
+            BedloadTrackerArg::Imm => Self::Imm,
+            BedloadTrackerArg::Det => Self::Det,
+        }
+    }
+}
+
+/// `sillage track bedload`.
+#[derive(Debug, Args)]
+pub struct TrackBedloadArgs {
+    /// Detections CSV: `frame,x,y,class,score` (frames 0-based; class 0 black, 1 transparent).
+    #[arg(long, value_name = "FILE")]
+    pub detections: PathBuf,
+    /// Detector-confidence candidates (Eq. (1)), same layout: every response maximum above a
+    /// low threshold with its score. Without it, a missed bead is pulled towards the
+    /// unclaimed detections of its class.
+    #[arg(long, value_name = "FILE")]
+    pub candidates: Option<PathBuf>,
+    /// Trajectories to write (CSV `frame,id,x,y,category,vx,vy,motion_state,spread_px`,
+    /// 1-based frames and pixels as BeadTracking's ground truth).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// TOML parameters (sections `association`, `likelihood`, `states`, `survival`,
+    /// `filter`, `motion`, ...; `sillage fit bedload` writes `motion`).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Override one key, e.g. `--set likelihood.gamma=0.7` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<String>,
+    /// Which tracker (overrides the config's `tracker`).
+    #[arg(long, value_enum)]
+    pub tracker: Option<BedloadTrackerArg>,
+    /// Random seed of the particles (overrides the config's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Print a machine-readable summary on stdout.
     #[arg(long)]
     pub json: bool,
 }

@@ -9,9 +9,11 @@ mod demo;
 mod eval;
 mod eval_inputs;
 mod eval_mot;
+mod fit;
 mod progress;
 mod ptv;
 mod synth;
+mod track;
 
 use clap::Parser;
 
@@ -25,6 +27,8 @@ fn main() {
         cli::Command::Demo(a) => demo::run(&a),
         cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
         cli::Command::Config(a) => ptv::print_config(&a),
+        cli::Command::Fit(cli::FitCommand::Bedload(a)) => fit::run_bedload(&a),
+        cli::Command::Track(cli::TrackCommand::Bedload(a)) => track::run_bedload(&a),
     };
     if let Err(error) = outcome {
         eprintln!("error: {error:#}");

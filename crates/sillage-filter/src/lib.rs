@@ -14,6 +14,8 @@
 //!   ([`BedloadModel`]), and constant position / velocity / acceleration
 //!   ([`KinematicModel`], [`Switching`]).
 //! - [`KalmanFilter`] and [`KalmanImm`] over small fixed-size matrices, for the IMM baseline.
+//! - [`fit_bedload`]: the transition table of Eq. (11) and the process noises of Eq. (3)
+//!   learned from ground-truth trajectories with motion states (§4.3), for `sillage fit bedload`.
 //!
 //! ```
 //! use sillage_core::{Point2, Vec2};
@@ -41,6 +43,7 @@
 //! assert!((estimate.mean.at(0) - 92.0).abs() < 2.0 && (estimate.mean.at(1) - 50.0).abs() < 2.0);
 //! ```
 
+pub mod fit;
 pub mod imm;
 pub mod kalman;
 pub mod linalg;
@@ -56,6 +59,9 @@ pub mod weights;
 mod filter;
 
 pub use filter::{FilterSpec, ParticleFilter, StepReport, StepSummary, step_all};
+pub use fit::{
+    BedloadFit, FitOptions, FitReport, StatePoint, StateTrack, apply_min_probability, fit_bedload,
+};
 pub use imm::KalmanImm;
 pub use kalman::{KalmanFilter, LinearGaussian, PositionMeasurement};
 pub use linalg::{Gaussian, Matrix, Vector};
