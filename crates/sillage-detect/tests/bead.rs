@@ -9,7 +9,9 @@
 use sillage_core::{Detection, Detector, FrameIndex, GrayImage, TruthPoint};
 use sillage_detect::{BeadDetections, BeadDetector, BeadParams};
 use sillage_eval::{DetectionScores, detection_scores};
-use sillage_io::{BeadCategory, read_bead_csv, read_bead_sequence_params, read_image};
+use sillage_io::{
+    BeadCategory, read_bead_csv, read_bead_sequence_params, read_image, read_matrix_csv,
+};
 
 const DATA: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -22,15 +24,7 @@ const MATCH_RADIUS_PX: f64 = 2.0;
 
 /// BeadTracking's ring template, read from its CSV export (21×21 values).
 fn ring_template() -> GrayImage {
-    let text = std::fs::read_to_string(format!("{DATA}/template_transparent_bead_rOut10_rIn6.csv"))
-        .unwrap();
-    let rows: Vec<Vec<f32>> = text
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').map(|v| v.trim().parse().unwrap()).collect())
-        .collect();
-    let side = rows.len();
-    GrayImage::from_vec(side, side, rows.concat()).unwrap()
+    read_matrix_csv(format!("{DATA}/template_transparent_bead_rOut10_rIn6.csv")).unwrap()
 }
 
 fn base_mask() -> GrayImage {

@@ -58,6 +58,7 @@ mod bead_tracks;
 mod beads;
 mod detections;
 mod frames;
+mod matrix;
 mod mot;
 mod mot_events;
 mod partial;
@@ -75,6 +76,7 @@ pub use detections::{
     DETECTIONS_HEADER, DetectionsCsvWriter, read_detections_csv, write_detections_csv,
 };
 pub use frames::{Frame, FrameOptions, FrameSource, open_frames, read_image, write_png16};
+pub use matrix::read_matrix_csv;
 pub use mot::{
     MotFileRole, MotResultsWriter, MotRow, MotSequenceFile, SeqInfo, parse_mot_rows, parse_seqinfo,
     read_mot_rows, read_mot_sequence, read_seqinfo, write_mot_results,

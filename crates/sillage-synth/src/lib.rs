@@ -1,8 +1,13 @@
-//! Seeded synthetic scenes with ground truth: the TracTrac vortex flow and its renderer.
+//! Seeded synthetic scenes with ground truth: the TracTrac vortex flow and its renderer, and
+//! the MMPF+ bedload sequence.
 //!
 //! - [`vortex`]: the unsteady, non-uniform vortex flow of the TracTrac paper (§4.1.1,
 //!   Eqs. 13-16), as positions only ([`VortexFlow`], [`VortexTruth`]) or as rendered frames
 //!   with truth ([`VortexSequence`]), plus its displacement statistics and `p⁻¹`.
+//! - [`bedload`]: beads resting, rolling and saltating over a packed bed, with motion states
+//!   (MMPF+ paper §3.5.1, §4.2), and detections made from them with misses, bursts of
+//!   misses, false positives and the detector-confidence candidates of Eq. (1)
+//!   ([`BedloadScene`], [`BeadDetectionModel`], [`BedloadSequence`]).
 //! - [`render_spots`]: Gaussian spots plus uniform or Gaussian noise, for any test or bench
 //!   that needs an image with known centres.
 //!
@@ -21,9 +26,16 @@
 //! assert!(frames[1].truth.iter().any(|p| p.vel_px_per_frame.is_some()));
 //! ```
 
+pub mod bedload;
 mod noise;
 mod render;
 pub mod vortex;
+
+pub use bedload::{
+    BeadDetectionModel, BedloadDetectionParams, BedloadFrame, BedloadObservation, BedloadParams,
+    BedloadSample, BedloadScene, BedloadSequence, MissCause, MissedBead, TrueBead,
+    generate_bedload,
+};
 
 pub use noise::{Noise, NoiseKind};
 pub use render::render_spots;

@@ -44,12 +44,14 @@
 //! # Ok::<(), sillage_core::Error>(())
 //! ```
 
+mod bead_tracks;
 mod bedload;
 mod etiseo;
 mod report;
 mod tally;
 mod vace;
 
+pub use bead_tracks::{BEAD_IOU_THRESHOLD, BeadTrackScores, score_bead_tracks};
 pub use bedload::{
     BedloadScores, MotionStateScores, StateLabel, StateScores, bedload_scores, motion_state_scores,
 };

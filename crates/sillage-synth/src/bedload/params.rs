@@ -1,0 +1,307 @@
+//! Parameters of the synthetic bedload scene (MMPF+ paper §3.5.1, §4.2, §4.3) and their checks.
+
+use serde::{Deserialize, Serialize};
+use sillage_core::{BLACK_BEAD_CLASS, Error, ObjectClass, Result};
+
+use super::bed::{bed_bead_count, lowest_surface_y};
+
+/// Parameters of the true bead motion. Defaults follow the paper's experimental sequence
+/// ExpSeq (§4.2) and the authors' BeadTracking code where they give a value, and documented
+/// choices elsewhere. Positions are px (y down, the bed at the bottom), speeds px/frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BedloadParams {
+    /// Frame width, px (default 1280, ExpSeq §4.2).
+    pub width: usize,
+    /// Frame height, px (default 320, ExpSeq §4.2).
+    pub height: usize,
+    /// Number of frames the scene yields (default 200).
+    pub n_frames: usize,
+    /// Black (coarse, 6 mm) beads in every frame, bed included (default 300: §4.2, "about
+    /// 300 coarse and 100 small beads").
+    pub n_black: usize,
+    /// Transparent (small, 4 mm) beads in every frame, all mobile (default 100, §4.2).
+    pub n_transparent: usize,
+    /// Full hexagonal layers of resting black beads that make the bed (default 6: 6 × 43 =
+    /// 258 beads across 1280 px, which leaves 42 mobile black beads).
+    pub bed_layers: usize,
+    /// Black bead radius, px (default 15: BeadTracking's radBlackBeadPx at 2.056e-4 m/px).
+    pub black_radius_px: f64,
+    /// Transparent bead radius, px (default 10: BeadTracking's radTransBeadPx).
+    pub transparent_radius_px: f64,
+    /// −1: the flow runs right to left (beads move towards −x), +1: left to right (default
+    /// −1, BeadTracking's flumeDirection).
+    pub flow_direction: i32,
+    /// Per-frame motion-state transition table, rows from (resting, rolling, saltating),
+    /// columns to the same (default Eq. (11) of the paper).
+    pub transition_probabilities: [[f64; 3]; 3],
+    /// Range `[min, max]` of rolling speeds along x, drawn at the start of each rolling spell
+    /// (default [1, 5] px/frame: between the code's u_rest = 0.561 and u_salt = 9.35).
+    pub rolling_speed_px_per_frame: [f64; 2],
+    /// Range of the horizontal speed of a saltation, drawn at its launch (default [10, 20]
+    /// px/frame, about BeadTracking's veloSaltInit = radSearch/2 = 15.5 px/frame).
+    pub saltation_speed_px_per_frame: [f64; 2],
+    /// Range of the vertical launch speed of each hop, which sets its duration
+    /// `round(2v/g)` (default [2, 8] px/frame: hops of 2 to 9 frames, apex up to 19 px).
+    pub launch_speed_px_per_frame: [f64; 2],
+    /// Gravity of the hops, px/frame² (default 1.7: the buoyancy-reduced gravity of glass
+    /// beads, 9.81·(1 − 1/2.5) m/s², at 130 frames/s and 2.056e-4 m/px).
+    pub gravity_px_per_frame2: f64,
+    /// Least height above the bed surface of a saltating bead between two contacts, px
+    /// (default 0.5); a hop too short to clear the bed's bumps is steepened to keep it.
+    pub hop_clearance_px: f64,
+    /// Largest displacement of a resting bead between two frames, px (default 0.05, at most
+    /// 0.1): the position is its rest point plus a uniform offset in a disk of half that.
+    pub resting_jitter_px: f64,
+    /// Radius of the static random offset of each bed bead from its lattice site, px
+    /// (default 0.5, at most a tenth of the black radius): beads roughly in contact.
+    pub bed_disorder_px: f64,
+    /// Seed of every random draw (default 0).
+    pub seed: u64,
+}
+
+impl Default for BedloadParams {
+    fn default() -> Self {
+        Self {
+            width: 1280,
+            height: 320,
+            n_frames: 200,
+            n_black: 300,
+            n_transparent: 100,
+            bed_layers: 6,
+            black_radius_px: 15.0,
+            transparent_radius_px: 10.0,
+            flow_direction: -1,
+            transition_probabilities: [[0.95, 0.05, 0.0], [0.07, 0.92, 0.01], [0.0, 0.09, 0.91]],
+            rolling_speed_px_per_frame: [1.0, 5.0],
+            saltation_speed_px_per_frame: [10.0, 20.0],
+            launch_speed_px_per_frame: [2.0, 8.0],
+            gravity_px_per_frame2: 1.7,
+            hop_clearance_px: 0.5,
+            resting_jitter_px: 0.05,
+            bed_disorder_px: 0.5,
+            seed: 0,
+        }
+    }
+}
+
+/// Largest frame side accepted, px.
+const MAX_SIDE: usize = 32_768;
+/// Largest number of beads of one class accepted.
+const MAX_BEADS: usize = 1_000_000;
+/// Largest speed accepted, px/frame.
+const MAX_SPEED: f64 = 1_000.0;
+
+impl BedloadParams {
+    /// Checks every value; the error names the key and its allowed range.
+    pub fn validate(&self) -> Result<()> {
+        for (key, side) in [("width", self.width), ("height", self.height)] {
+            if !(1..=MAX_SIDE).contains(&side) {
+                let message = format!("must be in 1..={MAX_SIDE}");
+                return Err(Error::parameter(key, side, message));
+            }
+        }
+        for (key, n) in [
+            ("n_black", self.n_black),
+            ("n_transparent", self.n_transparent),
+        ] {
+            if n > MAX_BEADS {
+                return Err(Error::parameter(key, n, format!("must be ≤ {MAX_BEADS}")));
+            }
+        }
+        let max_radius = self.width.min(self.height) as f64 / 4.0;
+        check("black_radius_px", self.black_radius_px, 0.5, max_radius)?;
+        check(
+            "transparent_radius_px",
+            self.transparent_radius_px,
+            0.5,
+            max_radius,
+        )?;
+        if self.flow_direction != -1 && self.flow_direction != 1 {
+            let message = "must be −1 (right to left) or +1 (left to right)";
+            return Err(Error::parameter(
+                "flow_direction",
+                self.flow_direction,
+                message,
+            ));
+        }
+        self.validate_transitions()?;
+        check_range(
+            "rolling_speed_px_per_frame",
+            self.rolling_speed_px_per_frame,
+            0.0,
+            MAX_SPEED,
+        )?;
+        let saltation = self.saltation_speed_px_per_frame;
+        check_range("saltation_speed_px_per_frame", saltation, 0.0, MAX_SPEED)?;
+        check_range(
+            "launch_speed_px_per_frame",
+            self.launch_speed_px_per_frame,
+            0.0,
+            MAX_SPEED,
+        )?;
+        check(
+            "gravity_px_per_frame2",
+            self.gravity_px_per_frame2,
+            0.01,
+            100.0,
+        )?;
+        check("hop_clearance_px", self.hop_clearance_px, 0.0, 100.0)?;
+        check("resting_jitter_px", self.resting_jitter_px, 0.0, 0.1)?;
+        check(
+            "bed_disorder_px",
+            self.bed_disorder_px,
+            0.0,
+            self.black_radius_px / 10.0,
+        )?;
+        self.validate_bed()
+    }
+
+    fn validate_transitions(&self) -> Result<()> {
+        for (from, row) in self.transition_probabilities.iter().enumerate() {
+            let sum: f64 = row.iter().sum();
+            let valid = row.iter().all(|p| p.is_finite() && (0.0..=1.0).contains(p));
+            if !valid || (sum - 1.0).abs() > 1e-6 {
+                return Err(Error::parameter(
+                    "transition_probabilities",
+                    format!("{row:?} (row {from})"),
+                    "each row (from resting, rolling, saltating) holds three probabilities in \
+                     [0, 1] that sum to 1",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_bed(&self) -> Result<()> {
+        let bed = bed_bead_count(self);
+        if self.n_black < bed {
+            return Err(Error::parameter(
+                "n_black",
+                self.n_black,
+                format!(
+                    "must be ≥ {bed}, the beads of {} full bed layers across {} px; lower \
+                     `bed_layers` or raise `n_black`",
+                    self.bed_layers, self.width
+                ),
+            ));
+        }
+        if lowest_surface_y(self) < 0.0 {
+            return Err(Error::parameter(
+                "bed_layers",
+                self.bed_layers,
+                format!(
+                    "the bed is taller than the {}-px frame; use fewer layers",
+                    self.height
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Radius of the beads of `class`, px (black for [`BLACK_BEAD_CLASS`], transparent else).
+    pub fn radius_px(&self, class: ObjectClass) -> f64 {
+        if class == BLACK_BEAD_CLASS {
+            self.black_radius_px
+        } else {
+            self.transparent_radius_px
+        }
+    }
+
+    /// The stationary distribution of the transition table over (resting, rolling,
+    /// saltating), by power iteration from the uniform one: the initial states of the mobile
+    /// beads.
+    pub fn stationary_distribution(&self) -> [f64; 3] {
+        let table = &self.transition_probabilities;
+        let mut p = [1.0 / 3.0; 3];
+        for _ in 0..10_000 {
+            let mut next = [0.0; 3];
+            for (from, row) in table.iter().enumerate() {
+                for (to, q) in row.iter().enumerate() {
+                    next[to] += p[from] * q;
+                }
+            }
+            p = next;
+        }
+        let sum: f64 = p.iter().sum();
+        p.map(|x| x / sum)
+    }
+}
+
+/// `value` must be finite and in `[low, high]`.
+pub(crate) fn check(key: &str, value: f64, low: f64, high: f64) -> Result<()> {
+    if value.is_finite() && (low..=high).contains(&value) {
+        Ok(())
+    } else {
+        let message = format!("must be a finite number in [{low}, {high}]");
+        Err(Error::parameter(key, value, message))
+    }
+}
+
+/// `range` must be `[min, max]` with `low ≤ min ≤ max ≤ high`, both finite.
+pub(crate) fn check_range(key: &str, range: [f64; 2], low: f64, high: f64) -> Result<()> {
+    let [min, max] = range;
+    let inside = |v: f64| v.is_finite() && (low..=high).contains(&v);
+    if inside(min) && inside(max) && min <= max {
+        Ok(())
+    } else {
+        let message = format!("must be [min, max] with {low} ≤ min ≤ max ≤ {high}");
+        Err(Error::parameter(key, format!("{range:?}"), message))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_leave_42_mobile_black_beads() {
+        let params = BedloadParams::default();
+        params.validate().unwrap();
+        assert_eq!(bed_bead_count(&params), 258);
+    }
+
+    #[test]
+    fn bad_values_name_their_key() {
+        type Case = (&'static str, fn(&mut BedloadParams));
+        let cases: [Case; 14] = [
+            ("width", |p| p.width = 0),
+            ("n_transparent", |p| p.n_transparent = usize::MAX),
+            ("n_black", |p| p.n_black = 100),
+            ("bed_layers", |p| (p.bed_layers, p.n_black) = (12, 600)),
+            ("black_radius_px", |p| p.black_radius_px = f64::NAN),
+            ("transparent_radius_px", |p| p.transparent_radius_px = 0.0),
+            ("flow_direction", |p| p.flow_direction = 0),
+            ("transition_probabilities", |p| {
+                p.transition_probabilities[0][0] = 0.9
+            }),
+            ("rolling_speed_px_per_frame", |p| {
+                p.rolling_speed_px_per_frame = [5.0, 1.0]
+            }),
+            ("saltation_speed_px_per_frame", |p| {
+                p.saltation_speed_px_per_frame[0] = -1.0
+            }),
+            ("launch_speed_px_per_frame", |p| {
+                p.launch_speed_px_per_frame[1] = f64::INFINITY
+            }),
+            ("gravity_px_per_frame2", |p| p.gravity_px_per_frame2 = 0.0),
+            ("resting_jitter_px", |p| p.resting_jitter_px = 0.2),
+            ("bed_disorder_px", |p| p.bed_disorder_px = 5.0),
+        ];
+        for (key, spoil) in cases {
+            let mut params = BedloadParams::default();
+            spoil(&mut params);
+            let err = params.validate().unwrap_err().to_string();
+            assert!(err.contains(&format!("`{key}`")), "{key}: {err}");
+        }
+    }
+
+    #[test]
+    fn stationary_distribution_of_eq_11_balances_the_flows() {
+        let p = BedloadParams::default().stationary_distribution();
+        // A birth-death chain: p_rest·0.05 = p_roll·0.07 and p_roll·0.01 = p_salt·0.09.
+        assert!((p[0] * 0.05 - p[1] * 0.07).abs() < 1e-9);
+        assert!((p[1] * 0.01 - p[2] * 0.09).abs() < 1e-9);
+        assert!((p.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+}
