@@ -32,8 +32,8 @@ mod render;
 pub mod vortex;
 
 pub use bedload::{
-    BeadDetectionModel, BedloadDetectionParams, BedloadFrame, BedloadObservation, BedloadParams,
-    BedloadSample, BedloadScene, BedloadSequence, MissCause, MissedBead, TrueBead,
+    BeadDetectionModel, BedloadDetectionParams, BedloadFrame, BedloadObservation, BedloadSample,
+    BedloadScene, BedloadSceneParams, BedloadSequence, MissCause, MissedBead, TrueBead,
     generate_bedload,
 };
 

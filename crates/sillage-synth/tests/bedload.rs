@@ -6,19 +6,19 @@ use std::collections::{HashMap, HashSet};
 
 use sillage_core::{BLACK_BEAD_CLASS, MotionState, TRANSPARENT_BEAD_CLASS, TrackId};
 use sillage_synth::{
-    BedloadDetectionParams, BedloadFrame, BedloadParams, BedloadScene, BedloadSequence,
+    BedloadDetectionParams, BedloadFrame, BedloadScene, BedloadSceneParams, BedloadSequence,
     generate_bedload,
 };
 
-fn frames(n_frames: usize, seed: u64) -> BedloadParams {
-    BedloadParams {
+fn frames(n_frames: usize, seed: u64) -> BedloadSceneParams {
+    BedloadSceneParams {
         n_frames,
         seed,
         ..Default::default()
     }
 }
 
-fn truth(params: BedloadParams) -> Vec<BedloadFrame> {
+fn truth(params: BedloadSceneParams) -> Vec<BedloadFrame> {
     BedloadScene::new(params).unwrap().collect()
 }
 
@@ -113,7 +113,7 @@ fn positions_stay_in_the_frame_and_displacements_below_the_search_radius() {
 #[test]
 fn motion_agrees_with_the_motion_state() {
     for flow_direction in [-1, 1] {
-        let params = BedloadParams {
+        let params = BedloadSceneParams {
             flow_direction,
             ..frames(2000, 4)
         };
@@ -245,7 +245,7 @@ fn bed_beads_touch_their_neighbours() {
 fn invalid_parameters_are_rejected_naming_their_key() {
     // Every key of both structs is checked by the unit tests of their modules; here, through
     // the constructors.
-    let scene = BedloadParams {
+    let scene = BedloadSceneParams {
         flow_direction: 0,
         ..Default::default()
     };
@@ -257,7 +257,7 @@ fn invalid_parameters_are_rejected_naming_their_key() {
         burst_length: 0,
         ..Default::default()
     };
-    let err = BedloadSequence::new(BedloadParams::default(), detection).unwrap_err();
+    let err = BedloadSequence::new(BedloadSceneParams::default(), detection).unwrap_err();
     assert!(err.to_string().contains("`burst_length`"), "{err}");
 }
 

@@ -6,12 +6,12 @@ use std::collections::{HashMap, HashSet};
 
 use sillage_core::{BLACK_BEAD_CLASS, TRANSPARENT_BEAD_CLASS, TrackId};
 use sillage_synth::{
-    BedloadDetectionParams, BedloadParams, BedloadSample, BedloadSequence, MissCause,
+    BedloadDetectionParams, BedloadSample, BedloadSceneParams, BedloadSequence, MissCause,
     generate_bedload,
 };
 
-fn frames(n_frames: usize, seed: u64) -> BedloadParams {
-    BedloadParams {
+fn frames(n_frames: usize, seed: u64) -> BedloadSceneParams {
+    BedloadSceneParams {
         n_frames,
         seed,
         ..Default::default()

@@ -200,3 +200,39 @@ fn bad_input_is_refused_with_the_frame() {
         .to_string();
     assert!(e.contains("increasing order"), "{e}");
 }
+
+#[test]
+fn a_lost_tracker_leaves_no_trail_of_predictions_unless_asked() {
+    // A lone transparent bead rolling at 4 px/frame, seen in frames 0..10 only.
+    let run_with = |at_once: bool| {
+        let params = BedloadTrackerParams {
+            emit_predictions_at_once: at_once,
+            ..BedloadTrackerParams::default()
+        };
+        let mut tracker = BedloadTracker::new(&params).unwrap();
+        let mut points = Vec::new();
+        for frame in 0..30u64 {
+            let p = Point2::new(600.0 - 4.0 * frame as f64, 200.0);
+            let detections: Vec<_> = (frame < 10)
+                .then(|| Detection::of_class(p, 0.5, 1))
+                .into_iter()
+                .collect();
+            tracker
+                .step(
+                    &FrameObservations::from_detections(frame, &detections),
+                    &mut points,
+                )
+                .unwrap();
+        }
+        tracker.finish(&mut points).unwrap();
+        points.iter().map(|p| p.frame).max().unwrap()
+    };
+    assert_eq!(
+        run_with(false),
+        9,
+        "held predictions dropped with the tracker"
+    );
+    // Emitted at once: the saltating survival limit (5 frames) of predictions — a bead
+    // touching no other is measured saltating by Eq. (4) (nbN ≤ nbN_salt = 0).
+    assert_eq!(run_with(true), 14);
+}

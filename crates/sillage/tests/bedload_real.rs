@@ -43,7 +43,9 @@ fn detections() -> Vec<BeadDetections> {
         .unwrap()
         .map(|frame| {
             let mut beads = BeadDetections::default();
-            detector.detect_beads(&frame.unwrap().image, &mut beads).unwrap();
+            detector
+                .detect_beads(&frame.unwrap().image, &mut beads)
+                .unwrap();
             beads
         })
         .collect()
@@ -80,7 +82,12 @@ fn track(kind: BedloadTrackerKind, frames: &[BeadDetections], radii: &[f64]) -> 
     let mut tracker = BedloadTracker::new(&params).unwrap();
     let mut points = Vec::new();
     for (frame, beads) in frames.iter().enumerate() {
-        let detections: Vec<_> = beads.black.iter().chain(&beads.transparent).copied().collect();
+        let detections: Vec<_> = beads
+            .black
+            .iter()
+            .chain(&beads.transparent)
+            .copied()
+            .collect();
         let observations = FrameObservations {
             candidates: &beads.candidates,
             ..FrameObservations::from_detections(frame as u64, &detections)
@@ -125,7 +132,11 @@ fn mmpf_plus_tracks_the_real_frames_as_well_as_the_paper_reports() {
     // BeadTracking's MMPF+ on its 20-frame version of this sequence: MOTA 99.70 %, 0 IDSW
     // (`shared/reference/beadtracking.md`); the paper's Table 1 on ExpSeq: 96.3 % correct
     // tracks.
-    assert!(mmpf_plus.mot.clear.mota >= 0.98, "MOTA {}", mmpf_plus.mot.clear.mota);
+    assert!(
+        mmpf_plus.mot.clear.mota >= 0.98,
+        "MOTA {}",
+        mmpf_plus.mot.clear.mota
+    );
     assert!(mmpf_plus.table1.correct_track_rate >= 0.95);
     assert!(mmpf_plus.table1.id_switches <= 2);
 }

@@ -4,7 +4,7 @@
 use rand::RngExt;
 use sillage_core::{BLACK_BEAD_CLASS, ObjectClass, Point2, RngStream, Vec2};
 
-use super::BedloadParams;
+use super::BedloadSceneParams;
 
 /// Sampling step of the surface tables, px.
 const SURFACE_STEP_PX: f64 = 0.25;
@@ -19,7 +19,7 @@ struct Site {
 
 /// How far the bed extends beyond the left and right edges, px: far enough that the
 /// surface near the edges is that of an unbroken bed.
-fn margin_px(params: &BedloadParams) -> f64 {
+fn margin_px(params: &BedloadSceneParams) -> f64 {
     let r_max = params.black_radius_px.max(params.transparent_radius_px);
     4.0 * params.black_radius_px + 2.0 * r_max
 }
@@ -27,7 +27,7 @@ fn margin_px(params: &BedloadParams) -> f64 {
 /// The lattice sites, bottom layer first, left to right: layer `j` has its centres at
 /// `y = height − 1 − r − j·√3·r` (the bottom layer on the frame's last row), spaced `2r`,
 /// odd layers shifted by `r`, so that every bead touches its six neighbours.
-fn sites(params: &BedloadParams) -> impl Iterator<Item = Site> + '_ {
+fn sites(params: &BedloadSceneParams) -> impl Iterator<Item = Site> + '_ {
     let r = params.black_radius_px;
     let last_x = params.width as f64 - 1.0;
     let margin = margin_px(params);
@@ -47,13 +47,13 @@ fn sites(params: &BedloadParams) -> impl Iterator<Item = Site> + '_ {
 }
 
 /// Number of bed beads inside the frame: all resting black beads of `bed_layers` layers.
-pub(crate) fn bed_bead_count(params: &BedloadParams) -> usize {
+pub(crate) fn bed_bead_count(params: &BedloadSceneParams) -> usize {
     sites(params).filter(|site| site.in_frame).count()
 }
 
 /// A lower bound of the surface's y for either class (its highest point): the top layer's
 /// crests, or the flume floor without a bed.
-pub(crate) fn lowest_surface_y(params: &BedloadParams) -> f64 {
+pub(crate) fn lowest_surface_y(params: &BedloadSceneParams) -> f64 {
     let r = params.black_radius_px;
     let r_max = r.max(params.transparent_radius_px);
     match params.bed_layers {
@@ -93,7 +93,7 @@ pub(crate) struct BedSurface {
 }
 
 impl BedSurface {
-    fn new(params: &BedloadParams, beads: &[Point2]) -> Self {
+    fn new(params: &BedloadSceneParams, beads: &[Point2]) -> Self {
         let margin = margin_px(params);
         let x0 = -margin;
         let len = ((params.width as f64 - 1.0 + 2.0 * margin) / SURFACE_STEP_PX).ceil() as usize;
@@ -138,7 +138,7 @@ pub(crate) struct Bed {
 
 impl Bed {
     /// The bed of `params`, its disorder drawn from `rng`.
-    pub(crate) fn new(params: &BedloadParams, rng: &mut RngStream) -> Self {
+    pub(crate) fn new(params: &BedloadSceneParams, rng: &mut RngStream) -> Self {
         let last = Point2::new(params.width as f64 - 1.0, params.height as f64 - 1.0);
         let mut all = Vec::new();
         let mut anchors = Vec::new();
@@ -164,7 +164,7 @@ mod tests {
 
     #[test]
     fn the_surface_touches_the_bed_without_overlapping_it() {
-        let params = BedloadParams::default();
+        let params = BedloadSceneParams::default();
         let mut rng = rng_stream(1, 0);
         let all: Vec<Point2> = sites(&params)
             .map(|site| site.pos + disk_offset(&mut rng, params.bed_disorder_px))
@@ -188,7 +188,7 @@ mod tests {
 
     #[test]
     fn no_bed_means_the_floor() {
-        let params = BedloadParams {
+        let params = BedloadSceneParams {
             bed_layers: 0,
             ..Default::default()
         };

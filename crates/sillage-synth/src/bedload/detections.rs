@@ -10,7 +10,7 @@ use sillage_core::{
 };
 
 use super::motion::uniform;
-use super::{BedloadDetectionParams, BedloadFrame, BedloadParams};
+use super::{BedloadDetectionParams, BedloadFrame, BedloadSceneParams};
 
 /// Streams of the detector model, apart from the scene's so that changing the detector
 /// leaves the truth alone, and apart from each other so that, e.g., more false positives
@@ -99,7 +99,7 @@ pub struct BeadDetectionModel {
 impl BeadDetectionModel {
     /// The model `params` describe for frames of `scene` (its size and its seed); fails on
     /// invalid parameters, naming the key.
-    pub fn new(params: BedloadDetectionParams, scene: &BedloadParams) -> Result<Self> {
+    pub fn new(params: BedloadDetectionParams, scene: &BedloadSceneParams) -> Result<Self> {
         params.validate()?;
         let seed = scene.seed;
         let false_positives = (params.false_positive_mean > 0.0)

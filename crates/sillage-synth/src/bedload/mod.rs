@@ -3,7 +3,7 @@
 //! with motion states, and detections made from them with misses, bursts of misses, false
 //! positives, position noise and the detector-confidence candidates of Eq. (1).
 //!
-//! - [`BedloadScene`] ([`BedloadParams`]): a static bed of black beads in hexagonal layers
+//! - [`BedloadScene`] ([`BedloadSceneParams`]): a static bed of black beads in hexagonal layers
 //!   in contact at the bottom of the frame (6 contacts inside the bed, as the motion-state
 //!   rule `nbN ≥ 5` expects), and mobile beads, black and transparent, resting on its
 //!   surface, rolling along it downstream or saltating above it in ballistic hops, their
@@ -21,9 +21,9 @@
 //!
 //! ```
 //! use sillage_core::MotionState;
-//! use sillage_synth::{BedloadDetectionParams, BedloadParams, generate_bedload};
+//! use sillage_synth::{BedloadDetectionParams, BedloadSceneParams, generate_bedload};
 //!
-//! let params = BedloadParams { n_frames: 3, ..Default::default() };
+//! let params = BedloadSceneParams { n_frames: 3, ..Default::default() };
 //! let frames = generate_bedload(params, BedloadDetectionParams::default())?;
 //! assert_eq!(frames.len(), 3);
 //! assert_eq!(frames[2].truth.beads.len(), 400);
@@ -46,6 +46,6 @@ mod sequence;
 
 pub use detection_params::BedloadDetectionParams;
 pub use detections::{BeadDetectionModel, BedloadObservation, MissCause, MissedBead};
-pub use params::BedloadParams;
+pub use params::BedloadSceneParams;
 pub use scene::{BedloadFrame, BedloadScene, TrueBead};
 pub use sequence::{BedloadSample, BedloadSequence, generate_bedload};

@@ -4,7 +4,7 @@
 use rand::RngExt;
 use sillage_core::{MotionState, ObjectClass, Point2, RngStream, TrackId};
 
-use super::BedloadParams;
+use super::BedloadSceneParams;
 use super::bed::{BedSurface, disk_offset};
 
 /// The motion-state order of the transition table's rows and columns.
@@ -47,7 +47,7 @@ pub(crate) fn uniform(rng: &mut RngStream, [min, max]: [f64; 2]) -> f64 {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Dynamics<'a> {
     /// The scene's parameters.
-    pub params: &'a BedloadParams,
+    pub params: &'a BedloadSceneParams,
     /// The surface the beads move on.
     pub surface: &'a BedSurface,
 }

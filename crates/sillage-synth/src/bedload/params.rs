@@ -10,7 +10,7 @@ use super::bed::{bed_bead_count, lowest_surface_y};
 /// choices elsewhere. Positions are px (y down, the bed at the bottom), speeds px/frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct BedloadParams {
+pub struct BedloadSceneParams {
     /// Frame width, px (default 1280, ExpSeq §4.2).
     pub width: usize,
     /// Frame height, px (default 320, ExpSeq §4.2).
@@ -60,7 +60,7 @@ pub struct BedloadParams {
     pub seed: u64,
 }
 
-impl Default for BedloadParams {
+impl Default for BedloadSceneParams {
     fn default() -> Self {
         Self {
             width: 1280,
@@ -92,7 +92,7 @@ const MAX_BEADS: usize = 1_000_000;
 /// Largest speed accepted, px/frame.
 const MAX_SPEED: f64 = 1_000.0;
 
-impl BedloadParams {
+impl BedloadSceneParams {
     /// Checks every value; the error names the key and its allowed range.
     pub fn validate(&self) -> Result<()> {
         for (key, side) in [("width", self.width), ("height", self.height)] {
@@ -256,14 +256,14 @@ mod tests {
 
     #[test]
     fn defaults_are_valid_and_leave_42_mobile_black_beads() {
-        let params = BedloadParams::default();
+        let params = BedloadSceneParams::default();
         params.validate().unwrap();
         assert_eq!(bed_bead_count(&params), 258);
     }
 
     #[test]
     fn bad_values_name_their_key() {
-        type Case = (&'static str, fn(&mut BedloadParams));
+        type Case = (&'static str, fn(&mut BedloadSceneParams));
         let cases: [Case; 14] = [
             ("width", |p| p.width = 0),
             ("n_transparent", |p| p.n_transparent = usize::MAX),
@@ -289,7 +289,7 @@ mod tests {
             ("bed_disorder_px", |p| p.bed_disorder_px = 5.0),
         ];
         for (key, spoil) in cases {
-            let mut params = BedloadParams::default();
+            let mut params = BedloadSceneParams::default();
             spoil(&mut params);
             let err = params.validate().unwrap_err().to_string();
             assert!(err.contains(&format!("`{key}`")), "{key}: {err}");
@@ -298,7 +298,7 @@ mod tests {
 
     #[test]
     fn stationary_distribution_of_eq_11_balances_the_flows() {
-        let p = BedloadParams::default().stationary_distribution();
+        let p = BedloadSceneParams::default().stationary_distribution();
         // A birth-death chain: p_rest·0.05 = p_roll·0.07 and p_roll·0.01 = p_salt·0.09.
         assert!((p[0] * 0.05 - p[1] * 0.07).abs() < 1e-9);
         assert!((p[1] * 0.01 - p[2] * 0.09).abs() < 1e-9);

@@ -7,7 +7,7 @@ use sillage_core::{
     TRANSPARENT_BEAD_CLASS, TrackId, TruthPoint, Vec2, rng_stream,
 };
 
-use super::BedloadParams;
+use super::BedloadSceneParams;
 use super::bed::{Bed, disk_offset};
 use super::motion::{Dynamics, Mover, uniform};
 
@@ -84,7 +84,7 @@ impl BedloadFrame {
 /// other. Streams frames `0..n_frames` in bounded memory.
 #[derive(Debug, Clone)]
 pub struct BedloadScene {
-    params: BedloadParams,
+    params: BedloadSceneParams,
     bed: Bed,
     bed_pos: Vec<Point2>,
     movers: Vec<Mover>,
@@ -99,7 +99,7 @@ impl BedloadScene {
     /// Frame 0 of the scene `params` describe; fails on invalid parameters, naming the key.
     /// Mobile beads start at uniform x on the surface, in states drawn from the table's
     /// stationary distribution.
-    pub fn new(params: BedloadParams) -> Result<Self> {
+    pub fn new(params: BedloadSceneParams) -> Result<Self> {
         params.validate()?;
         let bed = Bed::new(&params, &mut rng_stream(params.seed, STREAM_BED));
         let mut start = rng_stream(params.seed, STREAM_START);
@@ -149,7 +149,7 @@ impl BedloadScene {
     }
 
     /// The parameters of the scene.
-    pub fn params(&self) -> &BedloadParams {
+    pub fn params(&self) -> &BedloadSceneParams {
         &self.params
     }
 

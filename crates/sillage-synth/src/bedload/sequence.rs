@@ -4,8 +4,8 @@ use serde::{Deserialize, Serialize};
 use sillage_core::Result;
 
 use super::{
-    BeadDetectionModel, BedloadDetectionParams, BedloadFrame, BedloadObservation, BedloadParams,
-    BedloadScene,
+    BeadDetectionModel, BedloadDetectionParams, BedloadFrame, BedloadObservation, BedloadScene,
+    BedloadSceneParams,
 };
 
 /// One frame of a synthetic bedload sequence: the truth and what the detector reports.
@@ -28,7 +28,7 @@ pub struct BedloadSequence {
 impl BedloadSequence {
     /// The sequence `params` and `detection` describe; fails on invalid parameters, naming
     /// the key.
-    pub fn new(params: BedloadParams, detection: BedloadDetectionParams) -> Result<Self> {
+    pub fn new(params: BedloadSceneParams, detection: BedloadDetectionParams) -> Result<Self> {
         let detector = BeadDetectionModel::new(detection, &params)?;
         Ok(Self {
             scene: BedloadScene::new(params)?,
@@ -66,7 +66,7 @@ impl ExactSizeIterator for BedloadSequence {}
 /// Every frame of a short sequence at once (a long one streams through
 /// [`BedloadSequence`]).
 pub fn generate_bedload(
-    params: BedloadParams,
+    params: BedloadSceneParams,
     detection: BedloadDetectionParams,
 ) -> Result<Vec<BedloadSample>> {
     Ok(BedloadSequence::new(params, detection)?.collect())

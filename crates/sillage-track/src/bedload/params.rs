@@ -126,6 +126,12 @@ pub struct LikelihoodParams {
     pub support_px: f64,
     /// Which candidates make the density; default those no other tracker claimed.
     pub confidence_set: ConfidenceSet,
+    /// When no particle comes within this distance of the associated detection, px, the
+    /// particles restart around the detection and the tracker keeps its identity (ours: a
+    /// prediction that misses a take-off or a rebound otherwise leaves the estimate between
+    /// prediction and detection). Default 6 (3.5 σ of the default likelihood); none to
+    /// follow the paper.
+    pub recapture_distance_px: Option<f64>,
 }
 
 impl Default for LikelihoodParams {
@@ -136,6 +142,7 @@ impl Default for LikelihoodParams {
             lambda_per_px: 1.0,
             support_px: 10.0,
             confidence_set: ConfidenceSet::default(),
+            recapture_distance_px: Some(6.0),
         }
     }
 }
@@ -209,6 +216,11 @@ pub struct BedloadTrackerParams {
     /// The image, `[width, height]` px, when known: a missed tracker predicted outside it has
     /// left the field and ends (the code's edge rule). Default none.
     pub field_px: Option<[f64; 2]>,
+    /// Emit the points predicted through missed frames at once, as the paper and the authors'
+    /// code do. Default false: they are held until a detection is associated again and
+    /// dropped if the tracker ends first, so that a lost tracker leaves no trail of
+    /// predictions (false positives) behind; the output then lags by up to the survival limit.
+    pub emit_predictions_at_once: bool,
     /// Association, Eq. (2).
     pub association: AssociationParams,
     /// Observation model, Eqs. (1), (8), (9).
@@ -235,6 +247,7 @@ impl Default for BedloadTrackerParams {
             },
             radius_px: vec![15.0, 10.0],
             field_px: None,
+            emit_predictions_at_once: false,
             association: AssociationParams::default(),
             likelihood: LikelihoodParams::default(),
             states: StateParams::default(),
@@ -251,6 +264,7 @@ pub(crate) struct Settings {
     pub kind: BedloadTrackerKind,
     pub radius_px: Vec<f64>,
     pub field_px: Option<[f64; 2]>,
+    pub emit_predictions_at_once: bool,
     pub association: AssociationParams,
     pub likelihood: LikelihoodParams,
     pub rule: StateRule,
@@ -323,6 +337,9 @@ impl BedloadTrackerParams {
         )?;
         finite_positive("likelihood.lambda_per_px", l.lambda_per_px)?;
         finite_positive("likelihood.support_px", l.support_px)?;
+        if let Some(d) = l.recapture_distance_px {
+            finite_positive("likelihood.recapture_distance_px", d)?;
+        }
         let s = &self.states;
         finite_non_negative("states.speed_rest_m_per_s", s.speed_rest_m_per_s)?;
         finite_non_negative("states.speed_salt_m_per_s", s.speed_salt_m_per_s)?;
@@ -339,6 +356,7 @@ impl BedloadTrackerParams {
             kind: self.tracker,
             radius_px: self.radius_px.clone(),
             field_px: self.field_px,
+            emit_predictions_at_once: self.emit_predictions_at_once,
             association: a.clone(),
             likelihood: l.clone(),
             rule: StateRule {

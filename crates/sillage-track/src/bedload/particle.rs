@@ -53,6 +53,8 @@ pub(crate) struct Weighting<'a> {
     pub state_cue: Option<(f64, f64)>,
     /// The detector-confidence density of Eq. (1), for missed trackers.
     pub density: &'a ConfidenceDensity,
+    /// Squared recapture distance, px², and the model whose initial spread recaptures.
+    pub recapture: Option<(f64, &'a BedloadModel)>,
 }
 
 /// One SIR step of a tracker of class `class`; returns its estimate.
@@ -70,6 +72,16 @@ pub(crate) fn step(
             vel_px_per_frame,
             state,
         } => {
+            // Recapture (ours): when no particle came within the recapture distance of the
+            // associated detection, the likelihood cannot pull the estimate onto it; the
+            // particles restart around it, the tracker keeping its identity (the authors'
+            // code instead drops the association and starts a new track, §3.4 of
+            // `reference/beadtracking.md`).
+            if let Some((distance2, model)) = weighting.recapture
+                && nearest_squared(filter.particles(), pos_px) > distance2
+            {
+                filter.reinitialise(&model.initial_spread(pos_px));
+            }
             // §3.5.2: every particle takes the observed velocity, so the velocity likelihood
             // of Eq. (7) drops out.
             filter.particles_mut().set_velocity(vel_px_per_frame);
@@ -105,6 +117,16 @@ pub(crate) fn step(
         vel_px_per_frame: observed_velocity.unwrap_or(Vec2::new(mean(2), mean(3))),
         spread_px: Some(((estimate.cov.0[0][0] + estimate.cov.0[1][1]) / 2.0).sqrt()),
     }
+}
+
+/// Squared distance from `z` to the nearest particle.
+fn nearest_squared(particles: &Particles, z: Point2) -> f64 {
+    particles
+        .pos_x()
+        .iter()
+        .zip(particles.pos_y())
+        .map(|(&x, &y)| (x - z.x) * (x - z.x) + (y - z.y) * (y - z.y))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The motion state of a particle's mode (a single-model filter's mode 0 is `Unknown`).

@@ -53,6 +53,9 @@ struct Track {
     spread_px: Option<f64>,
     /// The birth point, emitted on confirmation.
     birth: TrackPoint,
+    /// Points predicted through the current run of misses, held until a detection confirms
+    /// them (unless `emit_predictions_at_once`).
+    held: Vec<TrackPoint>,
     /// Still tracked after this frame.
     alive: bool,
 }
@@ -261,6 +264,9 @@ impl BedloadTracker {
                 inv_two_variance: 1.0 / (2.0 * l.position_variance_px2),
                 state_cue,
                 density: &self.density,
+                recapture: l
+                    .recapture_distance_px
+                    .map(|d| (d * d, &self.settings.model)),
             },
         };
         self.tracks
@@ -329,13 +335,19 @@ impl BedloadTracker {
                     id
                 }
             };
-            self.emitted.push(TrackPoint {
+            let point = TrackPoint {
                 vel_px_per_frame: track.vel_px_per_frame,
                 motion_state: track.state,
                 class: track.class,
                 spread_px: track.spread_px,
                 ..TrackPoint::at(frame, track_id, track.pos_px)
-            });
+            };
+            if track.misses > 0 && !self.settings.emit_predictions_at_once {
+                track.held.push(point);
+            } else {
+                self.emitted.append(&mut track.held);
+                self.emitted.push(point);
+            }
         }
         self.tracks.retain(|t| t.alive);
         // 6. Births from the detections no tracker took.
@@ -362,6 +374,7 @@ impl BedloadTracker {
                 state: MotionState::Unknown,
                 misses: 0,
                 spread_px: None,
+                held: Vec::new(),
                 birth: TrackPoint {
                     class: detection.class,
                     ..TrackPoint::at(frame, 0, pos_px)
