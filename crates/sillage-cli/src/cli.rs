@@ -22,12 +22,14 @@ const EXAMPLES: &str = "Examples:
   sillage ptv movie.avi --out tracks.parquet --set detector.scale_px=3 --set tracker.motion_av=5
   sillage ptv frames/ --tractrac-par tifseq_par.txt --out tracks.csv
   sillage synth vortex --out vortex/ --frames 50 --particles 2000 --snr 6
+  sillage synth bedload --out beads/ --frames 200
   sillage eval ptv --truth vortex/truth.csv --tracks tracks.csv
   sillage eval mot --gt MOT17/train --pred tracker/data --protocol mot17
   sillage eval mot --gt vortex/truth.csv --pred tracks.csv --match dist:1 --json
   sillage bench ptv --particles 1000,5000,25000
   sillage fit bedload --truth trackdatatruth.csv --out motion.toml
-  sillage track bedload --detections det.csv --candidates cand.csv --config motion.toml --out tracks.csv";
+  sillage track bedload --detections beads/detections.csv --candidates beads/candidates.csv --out beads/tracks.csv
+  sillage eval mot --gt beads/truth.csv --pred beads/tracks.csv --match disc:0.43 --papers";
 
 /// The verbs.
 #[derive(Debug, Subcommand)]
@@ -106,6 +108,41 @@ pub struct PtvArgs {
 pub enum SynthCommand {
     /// The TracTrac paper's vortex flow (Eqs. 13-16): PNG frames and truth.csv.
     Vortex(VortexArgs),
+    /// Bedload beads (MMPF+ paper): truth with motion states, detections with misses, bursts
+    /// and false positives, and confidence candidates, as CSV.
+    Bedload(SynthBedloadArgs),
+}
+
+/// `sillage synth bedload`.
+#[derive(Debug, Args)]
+pub struct SynthBedloadArgs {
+    /// Output folder (created): truth.csv, detections.csv, candidates.csv, sequence_param.txt.
+    #[arg(long, short, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Number of frames (1280×320 px each).
+    #[arg(long, default_value_t = 200)]
+    pub frames: usize,
+    /// Black beads (a packed bed, the rest mobile).
+    #[arg(long, default_value_t = 300)]
+    pub black: usize,
+    /// Transparent beads (all mobile).
+    #[arg(long, default_value_t = 100)]
+    pub transparent: usize,
+    /// Probability that a transparent bead is missed in a frame.
+    #[arg(long, default_value_t = 0.03)]
+    pub miss: f64,
+    /// Probability per transparent bead and frame that a 5-frame run of misses starts.
+    #[arg(long, default_value_t = 0.01)]
+    pub burst: f64,
+    /// Mean number of false detections per frame.
+    #[arg(long, default_value_t = 1.0)]
+    pub false_positives: f64,
+    /// Standard deviation of the detection position noise, px.
+    #[arg(long, default_value_t = 0.5)]
+    pub noise: f64,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 /// `sillage synth vortex`.

@@ -13,6 +13,7 @@ mod fit;
 mod progress;
 mod ptv;
 mod synth;
+mod synth_bedload;
 mod track;
 
 use clap::Parser;
@@ -22,6 +23,7 @@ fn main() {
     let outcome = match args.command {
         cli::Command::Ptv(a) => ptv::run(&a),
         cli::Command::Synth(cli::SynthCommand::Vortex(a)) => synth::run_vortex(&a),
+        cli::Command::Synth(cli::SynthCommand::Bedload(a)) => synth_bedload::run_bedload(&a),
         cli::Command::Eval(cli::EvalCommand::Ptv(a)) => eval::run_ptv(&a),
         cli::Command::Eval(cli::EvalCommand::Mot(a)) => eval_mot::run(&a),
         cli::Command::Demo(a) => demo::run(&a),

@@ -212,3 +212,57 @@ fn bad_inputs_and_parameters_fail_with_clear_messages() {
     );
     assert_eq!(std::fs::read(&det).unwrap(), before);
 }
+
+#[test]
+fn synthetic_sequence_to_tracks_to_scores() {
+    let dir = tempfile::tempdir().unwrap();
+    let beads = dir.path().join("beads");
+    let output = sillage(&[
+        "synth",
+        "bedload",
+        "--out",
+        path_str(&beads),
+        "--frames",
+        "20",
+        "--transparent",
+        "40",
+        "--seed",
+        "4",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    for file in [
+        "truth.csv",
+        "detections.csv",
+        "candidates.csv",
+        "sequence_param.txt",
+    ] {
+        assert!(beads.join(file).exists(), "{file}");
+    }
+    let tracks = beads.join("tracks.csv");
+    let output = sillage(&[
+        "track",
+        "bedload",
+        "--detections",
+        path_str(&beads.join("detections.csv")),
+        "--candidates",
+        path_str(&beads.join("candidates.csv")),
+        "--out",
+        path_str(&tracks),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let output = sillage(&[
+        "eval",
+        "mot",
+        "--gt",
+        path_str(&beads.join("truth.csv")),
+        "--pred",
+        path_str(&tracks),
+        "--match",
+        "disc:0.43",
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let scores: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let mota = find(&scores, "mota").unwrap();
+    assert!(mota > 0.9, "MOTA {mota}");
+}

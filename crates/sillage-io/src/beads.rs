@@ -121,6 +121,21 @@ impl BeadSequenceParams {
     }
 }
 
+/// Writes `params` as a BeadTracking `sequence_param.txt` (`name<TAB>value<TAB>unit`),
+/// through a partial file renamed when complete.
+pub fn write_bead_sequence_params(
+    path: impl AsRef<Path>,
+    params: &BeadSequenceParams,
+) -> Result<()> {
+    let text = format!(
+        "diamBlackBead\t{}\tm\ndiamTransBead\t{}\tm\nmByPx\t{}\tm/px\n",
+        params.black_diameter_m, params.transparent_diameter_m, params.m_per_px
+    );
+    let mut file = crate::partial::PartialFile::create(path.as_ref())?;
+    file.write_all(text.as_bytes())?;
+    file.commit().map(drop)
+}
+
 /// Reads a BeadTracking `sequence_param.txt` (see [`parse_bead_sequence_params`]).
 pub fn read_bead_sequence_params(path: impl AsRef<Path>) -> Result<BeadSequenceParams> {
     let path = path.as_ref();
@@ -188,6 +203,19 @@ mod tests {
         let path = dir.path().join("truth.csv");
         std::fs::write(&path, text).unwrap();
         read_bead_csv(&path)
+    }
+
+    #[test]
+    fn sequence_params_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sequence_param.txt");
+        let params = BeadSequenceParams {
+            black_diameter_m: 0.006,
+            transparent_diameter_m: 0.004,
+            m_per_px: 2.056e-4,
+        };
+        write_bead_sequence_params(&path, &params).unwrap();
+        assert_eq!(read_bead_sequence_params(&path).unwrap(), params);
     }
 
     #[test]

@@ -70,7 +70,7 @@ mod truth;
 pub use bead_tracks::{BEAD_TRACK_HEADER, BeadCsvWriter};
 pub use beads::{
     BEAD_HEADER, BeadCategory, BeadPoint, BeadSequenceParams, parse_bead_sequence_params,
-    read_bead_csv, read_bead_sequence_params,
+    read_bead_csv, read_bead_sequence_params, write_bead_sequence_params,
 };
 pub use detections::{
     DETECTIONS_HEADER, DetectionsCsvWriter, read_detections_csv, write_detections_csv,

@@ -20,14 +20,7 @@ fn sequence() -> (Vec<BedloadSample>, BedloadSceneParams) {
 fn truth(samples: &[BedloadSample]) -> Vec<TrackPoint> {
     samples
         .iter()
-        .flat_map(|s| {
-            s.truth.beads.iter().map(|b| TrackPoint {
-                class: b.class,
-                motion_state: b.motion_state,
-                vel_px_per_frame: b.vel_px_per_frame,
-                ..TrackPoint::at(s.truth.index, b.track_id, b.pos_px)
-            })
-        })
+        .flat_map(|s| s.truth.track_points())
         .collect()
 }
 

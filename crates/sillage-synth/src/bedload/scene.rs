@@ -4,7 +4,7 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 use sillage_core::{
     BLACK_BEAD_CLASS, FrameIndex, MotionState, ObjectClass, Point2, Result, RngStream,
-    TRANSPARENT_BEAD_CLASS, TrackId, TruthPoint, Vec2, rng_stream,
+    TRANSPARENT_BEAD_CLASS, TrackId, TrackPoint, TruthPoint, Vec2, rng_stream,
 };
 
 use super::BedloadSceneParams;
@@ -60,6 +60,18 @@ impl BedloadFrame {
                 vel_px_per_frame: bead.vel_px_per_frame,
             })
             .collect()
+    }
+
+    /// The beads as track points with their class and motion state: the ground truth of
+    /// bedload trackers, as scored by `sillage_eval::papers::score_bead_tracks` and written in
+    /// BeadTracking's layout. Velocities as [`BedloadFrame::truth_points`].
+    pub fn track_points(&self) -> impl Iterator<Item = TrackPoint> + '_ {
+        self.beads.iter().map(|bead| TrackPoint {
+            vel_px_per_frame: bead.vel_px_per_frame,
+            motion_state: bead.motion_state,
+            class: bead.class,
+            ..TrackPoint::at(self.index, bead.track_id, bead.pos_px)
+        })
     }
 }
 
