@@ -28,6 +28,7 @@ const EXAMPLES: &str = "Examples:
   sillage eval mot --gt vortex/truth.csv --pred tracks.csv --match dist:1 --json
   sillage bench ptv --particles 1000,5000,25000
   sillage fit bedload --truth trackdatatruth.csv --out motion.toml
+  sillage detect bead 'flume/*.tif' --sequence-params sequence_param.txt --mask base.png --out det.csv --candidates cand.csv
   sillage track bedload --detections beads/detections.csv --candidates beads/candidates.csv --out beads/tracks.csv
   sillage eval mot --gt beads/truth.csv --pred beads/tracks.csv --match disc:0.43 --papers";
 
@@ -55,6 +56,9 @@ pub enum Command {
     /// Track detections with one of the object trackers and write trajectories.
     #[command(subcommand)]
     Track(TrackCommand),
+    /// Detect objects in every frame and write the detections as CSV.
+    #[command(subcommand)]
+    Detect(DetectCommand),
 }
 
 /// Where the configuration comes from; later sources override earlier ones.
@@ -522,6 +526,46 @@ pub struct TrackBedloadArgs {
     /// Random seed of the particles (overrides the config's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Print a machine-readable summary on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `sillage detect <kind>`.
+#[derive(Debug, Subcommand)]
+pub enum DetectCommand {
+    /// Bedload beads (MMPF+ paper §3.3): black beads by threshold, transparent beads by ring
+    /// correlation, and the detector-confidence candidates of Eq. (1).
+    Bead(DetectBeadArgs),
+}
+
+/// `sillage detect bead`.
+#[derive(Debug, Args)]
+pub struct DetectBeadArgs {
+    /// Frames: a folder, a quoted glob pattern, a multi-page TIFF or a video file.
+    pub input: String,
+    /// Detections CSV to write (`frame,x,y,class,score`; class 0 black, 1 transparent).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Candidates CSV to write (every correlation maximum above `candidate_threshold`).
+    #[arg(long, value_name = "FILE")]
+    pub candidates: Option<PathBuf>,
+    /// BeadTracking `sequence_param.txt`: bead diameters and scale.
+    #[arg(long, value_name = "FILE")]
+    pub sequence_params: Option<PathBuf>,
+    /// Image of the fixed flume base (white = base, never beads).
+    #[arg(long, value_name = "FILE")]
+    pub mask: Option<PathBuf>,
+    /// Ring template of the transparent beads: a CSV matrix or an image (default: built
+    /// from the bead sizes).
+    #[arg(long, value_name = "FILE")]
+    pub template: Option<PathBuf>,
+    /// TOML detector parameters (`BeadParams`).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Override one key, e.g. `--set transparent_threshold=0.23` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<String>,
     /// Print a machine-readable summary on stdout.
     #[arg(long)]
     pub json: bool,

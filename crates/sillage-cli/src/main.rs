@@ -6,6 +6,7 @@
 mod bench;
 mod cli;
 mod demo;
+mod detect;
 mod eval;
 mod eval_inputs;
 mod eval_mot;
@@ -31,6 +32,7 @@ fn main() {
         cli::Command::Config(a) => ptv::print_config(&a),
         cli::Command::Fit(cli::FitCommand::Bedload(a)) => fit::run_bedload(&a),
         cli::Command::Track(cli::TrackCommand::Bedload(a)) => track::run_bedload(&a),
+        cli::Command::Detect(cli::DetectCommand::Bead(a)) => detect::run_bead(&a),
     };
     if let Err(error) = outcome {
         eprintln!("error: {error:#}");
