@@ -99,9 +99,10 @@ fn track(kind: BedloadTrackerKind, frames: &[BeadDetections], radii: &[f64]) -> 
 }
 
 fn report(kind: BedloadTrackerKind, s: &BeadTrackScores) {
+    let f = |i: usize| s.states.by_state()[i].1.f_score.unwrap_or(f64::NAN);
     eprintln!(
         "{:>9}: correct tracks {:.1} % ({}/{}), MOTA {:.2} %, MOTP {:.2} %, FN {:.2} %, FP {:.2} %, \
-         IDSW {}, IDF1 {:.3}, HOTA {:.3}, states evaluated {}",
+         IDSW {}, IDF1 {:.3}, HOTA {:.3}, state F rest/roll/salt {:.2}/{:.2}/{:.2} over {}",
         kind.name(),
         100.0 * s.table1.correct_track_rate,
         s.table1.correct_tracks,
@@ -113,6 +114,9 @@ fn report(kind: BedloadTrackerKind, s: &BeadTrackScores) {
         s.table1.id_switches,
         s.mot.identity.idf1,
         s.mot.hota.hota,
+        f(0),
+        f(1),
+        f(2),
         s.states.evaluated,
     );
 }
