@@ -501,9 +501,13 @@ impl From<BedloadTrackerArg> for sillage::track::bedload::BedloadTrackerKind {
 /// `sillage track bedload`.
 #[derive(Debug, Args)]
 pub struct TrackBedloadArgs {
+    /// Frames to detect the beads in (a folder, a quoted glob, a multi-page TIFF or a video),
+    /// instead of `--detections`.
+    #[arg(required_unless_present = "detections", conflicts_with_all = ["detections", "candidates"])]
+    pub input: Option<String>,
     /// Detections CSV: `frame,x,y,class,score` (frames 0-based; class 0 black, 1 transparent).
     #[arg(long, value_name = "FILE")]
-    pub detections: PathBuf,
+    pub detections: Option<PathBuf>,
     /// Detector-confidence candidates (Eq. (1)), same layout: every response maximum above a
     /// low threshold with its score. Without it, a missed bead is pulled towards the
     /// unclaimed detections of its class.
@@ -526,6 +530,9 @@ pub struct TrackBedloadArgs {
     /// Random seed of the particles (overrides the config's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// The detector, when tracking frames.
+    #[command(flatten)]
+    pub detector: BeadDetectorArgs,
     /// Print a machine-readable summary on stdout.
     #[arg(long)]
     pub json: bool,
@@ -539,17 +546,9 @@ pub enum DetectCommand {
     Bead(DetectBeadArgs),
 }
 
-/// `sillage detect bead`.
-#[derive(Debug, Args)]
-pub struct DetectBeadArgs {
-    /// Frames: a folder, a quoted glob pattern, a multi-page TIFF or a video file.
-    pub input: String,
-    /// Detections CSV to write (`frame,x,y,class,score`; class 0 black, 1 transparent).
-    #[arg(long, short, value_name = "FILE")]
-    pub out: PathBuf,
-    /// Candidates CSV to write (every correlation maximum above `candidate_threshold`).
-    #[arg(long, value_name = "FILE")]
-    pub candidates: Option<PathBuf>,
+/// Options of the bead detector shared by `detect bead` and `track bedload FRAMES`.
+#[derive(Debug, Args, Clone, Default)]
+pub struct BeadDetectorArgs {
     /// BeadTracking `sequence_param.txt`: bead diameters and scale.
     #[arg(long, value_name = "FILE")]
     pub sequence_params: Option<PathBuf>,
@@ -562,10 +561,27 @@ pub struct DetectBeadArgs {
     pub template: Option<PathBuf>,
     /// TOML detector parameters (`BeadParams`).
     #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// Override one key, e.g. `--set transparent_threshold=0.23` (repeatable).
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub overrides: Vec<String>,
+    pub detector_config: Option<PathBuf>,
+    /// Override one detector key, e.g. `--detector-set transparent_threshold=0.23`
+    /// (repeatable).
+    #[arg(long = "detector-set", value_name = "KEY=VALUE")]
+    pub detector_overrides: Vec<String>,
+}
+
+/// `sillage detect bead`.
+#[derive(Debug, Args)]
+pub struct DetectBeadArgs {
+    /// Frames: a folder, a quoted glob pattern, a multi-page TIFF or a video file.
+    pub input: String,
+    /// Detections CSV to write (`frame,x,y,class,score`; class 0 black, 1 transparent).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Candidates CSV to write (every correlation maximum above `candidate_threshold`).
+    #[arg(long, value_name = "FILE")]
+    pub candidates: Option<PathBuf>,
+    /// The detector.
+    #[command(flatten)]
+    pub detector: BeadDetectorArgs,
     /// Print a machine-readable summary on stdout.
     #[arg(long)]
     pub json: bool,

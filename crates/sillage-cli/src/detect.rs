@@ -9,17 +9,18 @@ use serde::Serialize;
 use sillage::core::GrayImage;
 use sillage::detect::{BeadDetections, BeadDetector, BeadParams};
 use sillage::io::{
-    DetectionsCsvWriter, FrameOptions, open_frames, read_bead_sequence_params, read_image,
+    DetectionsCsvWriter, Frame, FrameOptions, open_frames, read_bead_sequence_params, read_image,
     read_matrix_csv,
 };
 use sillage::toml_config::{read_toml_file, set_key};
 
-use crate::cli::DetectBeadArgs;
+use crate::cli::{BeadDetectorArgs, DetectBeadArgs};
 use crate::progress::FrameProgress;
 
-/// Defaults, then `--config`, then the sizes of `--sequence-params`, then `--set`; validated.
-fn load_params(args: &DetectBeadArgs) -> Result<BeadParams> {
-    let mut params: BeadParams = match &args.config {
+/// Defaults, then `--detector-config`, then the sizes of `--sequence-params`, then
+/// `--detector-set`; validated.
+fn load_params(args: &BeadDetectorArgs) -> Result<BeadParams> {
+    let mut params: BeadParams = match &args.detector_config {
         Some(path) => read_toml_file(path)?,
         None => BeadParams::default(),
     };
@@ -29,11 +30,36 @@ fn load_params(args: &DetectBeadArgs) -> Result<BeadParams> {
         params.black_diameter_m = sequence.black_diameter_m;
         params.transparent_diameter_m = sequence.transparent_diameter_m;
     }
-    for assignment in &args.overrides {
+    for assignment in &args.detector_overrides {
         set_key(&mut params, assignment)?;
     }
     params.geometry()?;
     Ok(params)
+}
+
+/// The bead detector of the command line: parameters, base mask and ring template.
+pub fn build_detector(args: &BeadDetectorArgs) -> Result<BeadDetector> {
+    let mut detector = BeadDetector::new(load_params(args)?)?;
+    if let Some(path) = &args.mask {
+        detector = detector.with_base_mask(&read_image(path)?);
+    }
+    if let Some(path) = &args.template {
+        detector = detector
+            .with_ring_template(&read_template(path)?)
+            .with_context(|| format!("in {}", path.display()))?;
+    }
+    Ok(detector)
+}
+
+/// Detects the beads of one frame into `beads`; the error names the frame and its file.
+pub fn detect_frame(
+    detector: &mut BeadDetector,
+    frame: &Frame,
+    beads: &mut BeadDetections,
+) -> Result<()> {
+    detector
+        .detect_beads(&frame.image, beads)
+        .with_context(|| format!("frame {} ({})", frame.index, frame.path.display()))
 }
 
 /// A ring template from a CSV matrix (BeadTracking's exported `.mat`) or an image.
@@ -60,16 +86,7 @@ struct DetectSummary {
 
 /// `sillage detect bead INPUT --out FILE [--candidates FILE]`.
 pub fn run_bead(args: &DetectBeadArgs) -> Result<()> {
-    let params = load_params(args)?;
-    let mut detector = BeadDetector::new(params)?;
-    if let Some(path) = &args.mask {
-        detector = detector.with_base_mask(&read_image(path)?);
-    }
-    if let Some(path) = &args.template {
-        detector = detector
-            .with_ring_template(&read_template(path)?)
-            .with_context(|| format!("in {}", path.display()))?;
-    }
+    let mut detector = build_detector(&args.detector)?;
     let frames = open_frames(&args.input, &FrameOptions::default())?;
     let mut progress = FrameProgress::new(frames.len(), "detecting");
     let mut detections = DetectionsCsvWriter::create(&args.out)?;
@@ -90,9 +107,7 @@ pub fn run_bead(args: &DetectBeadArgs) -> Result<()> {
     let mut outcome: Result<()> = Ok(());
     for frame in frames {
         let step = frame.map_err(anyhow::Error::from).and_then(|frame| {
-            detector
-                .detect_beads(&frame.image, &mut beads)
-                .with_context(|| format!("frame {} ({})", frame.index, frame.path.display()))?;
+            detect_frame(&mut detector, &frame, &mut beads)?;
             both.clear();
             both.extend_from_slice(&beads.black);
             both.extend_from_slice(&beads.transparent);

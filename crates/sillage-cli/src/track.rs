@@ -1,5 +1,6 @@
 //! `sillage track bedload`: the bedload trackers (MMPF+ and the baselines of its Table 1) on
-//! detections read from CSV, trajectories written in BeadTracking's layout.
+//! detections read from CSV, or on frames through the bead detector; trajectories written in
+//! BeadTracking's layout.
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -7,11 +8,13 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use sillage::core::{Detection, FrameIndex, FrameObservations, Tracker};
-use sillage::io::{BeadCsvWriter, read_detections_csv};
+use sillage::detect::BeadDetections;
+use sillage::io::{BeadCsvWriter, FrameOptions, open_frames, read_detections_csv};
 use sillage::toml_config::{read_toml_file, set_key};
 use sillage::track::bedload::{BedloadTracker, BedloadTrackerParams};
 
 use crate::cli::TrackBedloadArgs;
+use crate::detect::{build_detector, detect_frame};
 use crate::progress::FrameProgress;
 
 /// Defaults, then `--config`, then `--set`, then `--tracker` and `--seed`; validated.
@@ -51,8 +54,8 @@ struct TrackSummary {
 /// The detections and candidates of each frame, in frame order.
 type FrameInputs = BTreeMap<FrameIndex, (Vec<Detection>, Vec<Detection>)>;
 
-fn read_inputs(args: &TrackBedloadArgs) -> Result<FrameInputs> {
-    let inputs = std::iter::once(&args.detections).chain(&args.candidates);
+fn read_inputs(args: &TrackBedloadArgs, detections: &std::path::Path) -> Result<FrameInputs> {
+    let inputs = std::iter::once(detections).chain(args.candidates.as_deref());
     for input in inputs {
         let same = match (input.canonicalize(), args.out.canonicalize()) {
             (Ok(a), Ok(b)) => a == b,
@@ -66,8 +69,8 @@ fn read_inputs(args: &TrackBedloadArgs) -> Result<FrameInputs> {
         );
     }
     let mut frames = FrameInputs::new();
-    for (frame, detections) in read_detections_csv(&args.detections)? {
-        frames.entry(frame).or_default().0 = detections;
+    for (frame, found) in read_detections_csv(detections)? {
+        frames.entry(frame).or_default().0 = found;
     }
     if let Some(path) = &args.candidates {
         for (frame, candidates) in read_detections_csv(path)? {
@@ -77,45 +80,88 @@ fn read_inputs(args: &TrackBedloadArgs) -> Result<FrameInputs> {
     anyhow::ensure!(
         !frames.is_empty(),
         "{} holds no detection; give a file with rows `frame,x,y,class,score`",
-        args.detections.display()
+        detections.display()
     );
     Ok(frames)
+}
+
+/// One frame of input: its index, detections and candidates.
+type FrameInput = (FrameIndex, Vec<Detection>, Vec<Detection>);
+
+/// The frames of `input`, each detected by the bead detector of the command line.
+fn detected_frames(
+    args: &TrackBedloadArgs,
+    input: &str,
+) -> Result<(Option<usize>, Box<dyn Iterator<Item = Result<FrameInput>>>)> {
+    let mut detector = build_detector(&args.detector)?;
+    let frames = open_frames(input, &FrameOptions::default())?;
+    let total = frames.len();
+    let mut beads = BeadDetections::default();
+    let detected = frames.map(move |frame| {
+        let frame = frame?;
+        detect_frame(&mut detector, &frame, &mut beads)?;
+        let mut found = beads.black.clone();
+        found.extend_from_slice(&beads.transparent);
+        Ok((frame.index, found, beads.candidates.clone()))
+    });
+    Ok((total, Box::new(detected)))
 }
 
 /// `sillage track bedload --detections FILE --out FILE`.
 pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     let params = load_bedload_params(args)?;
-    let inputs = read_inputs(args)?;
+    let (total, frames): (Option<usize>, Box<dyn Iterator<Item = Result<FrameInput>>>) =
+        match (&args.input, &args.detections) {
+            (Some(input), _) => detected_frames(args, input)?,
+            (None, Some(detections)) => {
+                let inputs = read_inputs(args, detections)?;
+                let total = inputs.len();
+                let frames = inputs.into_iter().map(|(f, (d, c))| Ok((f, d, c)));
+                (Some(total), Box::new(frames))
+            }
+            (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
+        };
     let mut tracker = BedloadTracker::new(&params)?;
     let mut writer = BeadCsvWriter::create(&args.out)?;
-    let mut progress = FrameProgress::new(Some(inputs.len()), "tracking");
+    let mut progress = FrameProgress::new(total, "tracking");
     let start = Instant::now();
     let mut outcome = Ok(());
-    for (&frame, (detections, candidates)) in &inputs {
-        let observations = FrameObservations {
-            candidates,
-            ..FrameObservations::from_detections(frame, detections)
-        };
-        outcome = tracker.step(&observations, &mut writer);
-        if outcome.is_err() {
+    let (mut n_detections, mut n_candidates) = (0, 0);
+    for input in frames {
+        let step = input.and_then(|(frame, detections, candidates)| {
+            n_detections += detections.len();
+            n_candidates += candidates.len();
+            let observations = FrameObservations {
+                candidates: &candidates,
+                ..FrameObservations::from_detections(frame, &detections)
+            };
+            Ok(tracker.step(&observations, &mut writer)?)
+        });
+        if let Err(e) = step {
+            outcome = Err(e);
             break;
         }
         progress.tick();
     }
     if outcome.is_ok() {
-        outcome = tracker.finish(&mut writer);
+        outcome = tracker.finish(&mut writer).map_err(anyhow::Error::from);
     }
     progress.finish();
     let elapsed = start.elapsed().as_secs_f64();
     // Rows written before an error stay valid: the file is completed either way.
     let written = writer.finish()?;
-    outcome.with_context(|| format!("while tracking {}", args.detections.display()))?;
+    let source = match (&args.input, &args.detections) {
+        (Some(input), _) => input.clone(),
+        (None, Some(path)) => path.display().to_string(),
+        (None, None) => String::new(),
+    };
+    outcome.with_context(|| format!("while tracking {source}"))?;
     let stats = tracker.stats();
     let summary = TrackSummary {
         tracker: params.tracker.name(),
         frames: stats.frames,
-        detections: inputs.values().map(|(d, _)| d.len()).sum(),
-        candidates: inputs.values().map(|(_, c)| c.len()).sum(),
+        detections: n_detections,
+        candidates: n_candidates,
         tracks: stats.tracks,
         points: written.rows,
         coasted_points: stats.coasted,

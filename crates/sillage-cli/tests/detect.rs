@@ -90,7 +90,7 @@ fn bad_detector_input_is_a_clear_error() {
         "detect",
         "bead",
         &format!("{DATA}/images"),
-        "--set",
+        "--detector-set",
         "transparent_threshold=2",
         "--out",
         path_str(&out),
@@ -107,5 +107,35 @@ fn bad_detector_input_is_a_clear_error() {
         stderr(&output).contains("no/such/folder"),
         "{}",
         stderr(&output)
+    );
+}
+
+#[test]
+fn track_bedload_detects_frames_itself() {
+    let dir = tempfile::tempdir().unwrap();
+    let tracks = dir.path().join("tracks.csv");
+    let output = sillage(&[
+        "track",
+        "bedload",
+        &format!("{DATA}/images"),
+        "--sequence-params",
+        &format!("{DATA}/sequence_param.txt"),
+        "--mask",
+        MASK,
+        "--out",
+        path_str(&tracks),
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let summary: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(summary["frames"], 10);
+    let tracks_found = summary["tracks"].as_u64().unwrap();
+    // 397 true beads in the ten frames.
+    assert!((390..=405).contains(&tracks_found), "{summary}");
+    let output = sillage(&["track", "bedload", "--out", path_str(&tracks)]);
+    assert_eq!(
+        output.status.code(),
+        Some(2),
+        "frames or --detections are required"
     );
 }
