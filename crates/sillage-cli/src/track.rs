@@ -88,11 +88,11 @@ fn read_inputs(args: &TrackBedloadArgs, detections: &std::path::Path) -> Result<
 /// One frame of input: its index, detections and candidates.
 type FrameInput = (FrameIndex, Vec<Detection>, Vec<Detection>);
 
+/// The frames to track (their number when known) and the input of each.
+type FrameStream = (Option<usize>, Box<dyn Iterator<Item = Result<FrameInput>>>);
+
 /// The frames of `input`, each detected by the bead detector of the command line.
-fn detected_frames(
-    args: &TrackBedloadArgs,
-    input: &str,
-) -> Result<(Option<usize>, Box<dyn Iterator<Item = Result<FrameInput>>>)> {
+fn detected_frames(args: &TrackBedloadArgs, input: &str) -> Result<FrameStream> {
     let mut detector = build_detector(&args.detector)?;
     let frames = open_frames(input, &FrameOptions::default())?;
     let total = frames.len();
@@ -110,17 +110,16 @@ fn detected_frames(
 /// `sillage track bedload --detections FILE --out FILE`.
 pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     let params = load_bedload_params(args)?;
-    let (total, frames): (Option<usize>, Box<dyn Iterator<Item = Result<FrameInput>>>) =
-        match (&args.input, &args.detections) {
-            (Some(input), _) => detected_frames(args, input)?,
-            (None, Some(detections)) => {
-                let inputs = read_inputs(args, detections)?;
-                let total = inputs.len();
-                let frames = inputs.into_iter().map(|(f, (d, c))| Ok((f, d, c)));
-                (Some(total), Box::new(frames))
-            }
-            (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
-        };
+    let (total, frames): FrameStream = match (&args.input, &args.detections) {
+        (Some(input), _) => detected_frames(args, input)?,
+        (None, Some(detections)) => {
+            let inputs = read_inputs(args, detections)?;
+            let total = inputs.len();
+            let frames = inputs.into_iter().map(|(f, (d, c))| Ok((f, d, c)));
+            (Some(total), Box::new(frames))
+        }
+        (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
+    };
     let mut tracker = BedloadTracker::new(&params)?;
     let mut writer = BeadCsvWriter::create(&args.out)?;
     let mut progress = FrameProgress::new(total, "tracking");
