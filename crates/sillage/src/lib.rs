@@ -17,6 +17,7 @@
 //! # Ok::<(), sillage::core::Error>(())
 //! ```
 
+pub mod bedload;
 pub mod config;
 pub mod pipeline;
 pub mod toml_config;

@@ -2,16 +2,15 @@
 //! (`shared/data/bedload_beads_lafaye2018`), scored against their hand-edited truth as the
 //! paper scores (disc IoU ≥ 0.43; Table 1's correct tracks, MOTA, identity switches).
 
-use sillage::core::{
-    BLACK_BEAD_CLASS, FrameObservations, GrayImage, TRANSPARENT_BEAD_CLASS, TrackPoint, Tracker,
-};
+use sillage::bedload::{BeadFrame, bedload_table};
+use sillage::core::{BLACK_BEAD_CLASS, GrayImage, TRANSPARENT_BEAD_CLASS, TrackPoint};
 use sillage::detect::{BeadDetections, BeadDetector, BeadParams};
-use sillage::eval::papers::{BeadTrackScores, score_bead_tracks};
+use sillage::eval::papers::BeadTrackScores;
 use sillage::io::{
     BeadCategory, FrameOptions, open_frames, read_bead_csv, read_bead_sequence_params, read_image,
     read_matrix_csv,
 };
-use sillage::track::bedload::{BedloadTracker, BedloadTrackerKind, BedloadTrackerParams};
+use sillage::track::bedload::{BedloadTrackerKind, BedloadTrackerParams};
 
 const DATA: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -73,31 +72,6 @@ fn truth() -> (Vec<TrackPoint>, Vec<f64>) {
     (points, radii)
 }
 
-fn track(kind: BedloadTrackerKind, frames: &[BeadDetections], radii: &[f64]) -> Vec<TrackPoint> {
-    let params = BedloadTrackerParams {
-        tracker: kind,
-        radius_px: radii.to_vec(),
-        ..BedloadTrackerParams::default()
-    };
-    let mut tracker = BedloadTracker::new(&params).unwrap();
-    let mut points = Vec::new();
-    for (frame, beads) in frames.iter().enumerate() {
-        let detections: Vec<_> = beads
-            .black
-            .iter()
-            .chain(&beads.transparent)
-            .copied()
-            .collect();
-        let observations = FrameObservations {
-            candidates: &beads.candidates,
-            ..FrameObservations::from_detections(frame as u64, &detections)
-        };
-        tracker.step(&observations, &mut points).unwrap();
-    }
-    tracker.finish(&mut points).unwrap();
-    points
-}
-
 fn report(kind: BedloadTrackerKind, s: &BeadTrackScores) {
     let f = |i: usize| s.states.by_state()[i].1.f_score.unwrap_or(f64::NAN);
     eprintln!(
@@ -126,11 +100,27 @@ fn mmpf_plus_tracks_the_real_frames_as_well_as_the_paper_reports() {
     let frames = detections();
     assert_eq!(frames.len(), 10);
     let (truth, radii) = truth();
-    let mut scores = Vec::new();
-    for kind in BedloadTrackerKind::ALL {
-        let s = score_bead_tracks(&truth, &track(kind, &frames, &radii), &radii).unwrap();
-        report(kind, &s);
-        scores.push((kind, s));
+    let frames: Vec<BeadFrame> = frames
+        .into_iter()
+        .enumerate()
+        .map(|(frame, beads)| BeadFrame {
+            frame: frame as u64,
+            detections: beads
+                .black
+                .iter()
+                .chain(&beads.transparent)
+                .copied()
+                .collect(),
+            candidates: beads.candidates,
+        })
+        .collect();
+    let params = BedloadTrackerParams {
+        radius_px: radii.clone(),
+        ..BedloadTrackerParams::default()
+    };
+    let scores = bedload_table(&params, &BedloadTrackerKind::ALL, &frames, &truth).unwrap();
+    for (kind, s) in &scores {
+        report(*kind, s);
     }
     let mmpf_plus = &scores[0].1;
     // BeadTracking's MMPF+ on its 20-frame version of this sequence: MOTA 99.70 %, 0 IDSW

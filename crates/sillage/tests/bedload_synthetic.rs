@@ -2,10 +2,11 @@
 //! (a packed bed under rolling and saltating beads), transparent beads missed at random and in
 //! 5-frame bursts, false positives, position noise; the five trackers on the same detections.
 
-use sillage::core::{TrackPoint, Tracker};
-use sillage::eval::papers::{BeadTrackScores, score_bead_tracks};
+use sillage::bedload::{BeadFrame, bedload_table};
+use sillage::core::TrackPoint;
+use sillage::eval::papers::BeadTrackScores;
 use sillage::synth::{BedloadDetectionParams, BedloadSample, BedloadSceneParams, generate_bedload};
-use sillage::track::bedload::{BedloadTracker, BedloadTrackerKind, BedloadTrackerParams};
+use sillage::track::bedload::{BedloadTrackerKind, BedloadTrackerParams};
 
 fn sequence() -> (Vec<BedloadSample>, BedloadSceneParams) {
     let scene = BedloadSceneParams {
@@ -24,21 +25,16 @@ fn truth(samples: &[BedloadSample]) -> Vec<TrackPoint> {
         .collect()
 }
 
-fn track(kind: BedloadTrackerKind, samples: &[BedloadSample], radii: &[f64]) -> Vec<TrackPoint> {
-    let params = BedloadTrackerParams {
-        tracker: kind,
-        radius_px: radii.to_vec(),
-        ..BedloadTrackerParams::default()
-    };
-    let mut tracker = BedloadTracker::new(&params).unwrap();
-    let mut points = Vec::new();
-    for sample in samples {
-        tracker
-            .step(&sample.observation.observations(), &mut points)
-            .unwrap();
-    }
-    tracker.finish(&mut points).unwrap();
-    points
+/// The detections and candidates of every frame.
+fn frames(samples: &[BedloadSample]) -> Vec<BeadFrame> {
+    samples
+        .iter()
+        .map(|s| BeadFrame {
+            frame: s.truth.index,
+            detections: s.observation.detections.clone(),
+            candidates: s.observation.candidates.clone(),
+        })
+        .collect()
 }
 
 fn report(kind: BedloadTrackerKind, s: &BeadTrackScores) {
@@ -68,14 +64,15 @@ fn table1_on_a_synthetic_sequence() {
     let (samples, scene) = sequence();
     let radii = [scene.black_radius_px, scene.transparent_radius_px];
     let truth = truth(&samples);
-    let scores: Vec<_> = BedloadTrackerKind::ALL
-        .iter()
-        .map(|&kind| {
-            let s = score_bead_tracks(&truth, &track(kind, &samples, &radii), &radii).unwrap();
-            report(kind, &s);
-            (kind, s)
-        })
-        .collect();
+    let params = BedloadTrackerParams {
+        radius_px: radii.to_vec(),
+        ..BedloadTrackerParams::default()
+    };
+    let scores =
+        bedload_table(&params, &BedloadTrackerKind::ALL, &frames(&samples), &truth).unwrap();
+    for (kind, s) in &scores {
+        report(*kind, s);
+    }
     let get = |kind| &scores.iter().find(|(k, _)| *k == kind).unwrap().1;
     let (mmpf_plus, det) = (
         get(BedloadTrackerKind::MmpfPlus),
