@@ -10,6 +10,9 @@
 //! - [`LapSolver`] / [`solve_assignment`]: optimal one-to-one assignment on a dense
 //!   rectangular cost matrix with forbidden pairs (Jonker–Volgenant shortest augmenting
 //!   paths), checked against exhaustive search.
+//! - [`SparseLapSolver`]: the same problem on a sparse matrix (adjacency lists), in time
+//!   that grows with the allowed entries; it says whether its optimum is the only one, so
+//!   that callers needing [`LapSolver`]'s tie-breaking can fall back to it on ties.
 //!
 //! Ties are broken deterministically: among points at the same distance the lower index wins.
 //! Points with a non-finite coordinate are never returned, and a non-finite query finds nothing.
@@ -32,6 +35,13 @@
 //! // Row 1 may only take column 0: row 0 yields it, as two pairs beat one cheaper pair.
 //! let costs = [1.0, 2.0, 1.0, f64::INFINITY];
 //! assert_eq!(sillage_assoc::solve_assignment(2, 2, &costs), vec![Some(1), Some(0)]);
+//!
+//! // The same problem given sparsely, row by row (row 1 lists only column 0).
+//! use sillage_assoc::{Pairing, SparseLapSolver};
+//! let mut sparse = SparseLapSolver::new();
+//! let pairs = sparse.solve(2, 2, &[0, 2, 3], &[0, 1, 0], &[1.0, 2.0, 1.0], Pairing::Maximum);
+//! assert_eq!(pairs, &[Some(1), Some(0)]);
+//! assert!(sparse.is_unique());
 //! ```
 
 mod brute;
@@ -39,9 +49,11 @@ mod grid;
 mod index;
 pub mod lap;
 mod mutual;
+pub mod sparse_lap;
 
 pub use brute::BruteForceIndex;
 pub use grid::PointIndex;
 pub use index::{Neighbour, NeighbourIndex};
 pub use lap::{LapSolver, solve_assignment};
 pub use mutual::{mutual_nearest_neighbours, mutual_pairs};
+pub use sparse_lap::{Pairing, SparseLapSolver};

@@ -27,6 +27,7 @@ const EXAMPLES: &str = "Examples:
   sillage eval mot --gt MOT17/train --pred tracker/data --protocol mot17
   sillage eval mot --gt vortex/truth.csv --pred tracks.csv --match dist:1 --json
   sillage bench ptv --particles 1000,5000,25000
+  sillage bench bedload --frames 100 --real shared/data/bedload_beads_lafaye2018 --mask base.png
   sillage fit bedload --truth trackdatatruth.csv --out motion.toml
   sillage detect bead 'flume/*.tif' --sequence-params sequence_param.txt --mask base.png --out det.csv --candidates cand.csv
   sillage track bedload --detections beads/detections.csv --candidates beads/candidates.csv --out beads/tracks.csv
@@ -407,6 +408,30 @@ pub struct DemoArgs {
 pub enum BenchCommand {
     /// Detection and tracking time per frame on synthetic vortex frames.
     Ptv(BenchPtvArgs),
+    /// Table 1 of the MMPF+ paper: the five bedload trackers scored on a synthetic sequence
+    /// and, with --real, on a real one with the τ_t sweep of Fig. 6.
+    Bedload(BenchBedloadArgs),
+}
+
+/// `sillage bench bedload`.
+#[derive(Debug, Args)]
+pub struct BenchBedloadArgs {
+    /// Frames of the synthetic sequence.
+    #[arg(long, default_value_t = 100)]
+    pub frames: usize,
+    /// Seed of the synthetic sequence.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// A real sequence in BeadTracking's layout (images/, ground_truth/trackdatatruth.csv,
+    /// sequence_param.txt), detected with the options below.
+    #[arg(long, value_name = "DIR")]
+    pub real: Option<PathBuf>,
+    /// The detector, for --real.
+    #[command(flatten)]
+    pub detector: BeadDetectorArgs,
+    /// Print the rows as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `sillage bench ptv`.

@@ -4,6 +4,7 @@
 //! the fix), 2 on a bad command line.
 
 mod bench;
+mod bench_bedload;
 mod cli;
 mod demo;
 mod detect;
@@ -29,6 +30,7 @@ fn main() {
         cli::Command::Eval(cli::EvalCommand::Mot(a)) => eval_mot::run(&a),
         cli::Command::Demo(a) => demo::run(&a),
         cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
+        cli::Command::Bench(cli::BenchCommand::Bedload(a)) => bench_bedload::run(&a),
         cli::Command::Config(a) => ptv::print_config(&a),
         cli::Command::Fit(cli::FitCommand::Bedload(a)) => fit::run_bedload(&a),
         cli::Command::Track(cli::TrackCommand::Bedload(a)) => track::run_bedload(&a),

@@ -266,3 +266,20 @@ fn synthetic_sequence_to_tracks_to_scores() {
     let mota = find(&scores, "mota").unwrap();
     assert!(mota > 0.9, "MOTA {mota}");
 }
+
+#[test]
+fn bench_bedload_prints_table1_for_the_five_trackers() {
+    let output = sillage(&["bench", "bedload", "--frames", "15", "--json"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let rows: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let rows = rows.as_array().unwrap();
+    let trackers: Vec<_> = rows
+        .iter()
+        .map(|r| r["tracker"].as_str().unwrap())
+        .collect();
+    assert_eq!(trackers, ["mmpf_plus", "mmpf", "pf", "imm", "det"]);
+    for row in rows {
+        let mota = find(&row["scores"], "mota").unwrap();
+        assert!(mota > 0.9 && mota <= 1.0, "{row}");
+    }
+}

@@ -1,10 +1,12 @@
 //! CLEAR MOT + Identity + HOTA: on TUD-Stadtmitte (py-motmetrics' reference files) and on
-//! synthetic sequences of 10^5 to 10^6 truth rows against as many estimates (linear time).
+//! synthetic sequences of 10^5 to 10^6 truth rows against as many estimates (linear time);
+//! on a packed bead bed, where slightly overlapping discs make each frame's similarity graph
+//! one large sparse component.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use sillage_eval::mot::{
     BoundingBox, MotChallengeProtocol, MotData, MotEstimate, MotParams, MotTruth, Shape,
-    Similarity, evaluate_mot,
+    Similarity, TruthRole, evaluate_mot,
 };
 use sillage_io::{MotRow, read_mot_rows};
 
@@ -95,5 +97,83 @@ fn bench_synthetic(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_tud, bench_synthetic);
+/// A packed bead bed seen over `frames` frames: 260 discs of radius 15 px on a hexagonal
+/// lattice of 30 px spacing with ±0.5 px jitter per frame (neighbours overlap slightly),
+/// plus 140 discs of radius 10 px drifting across it; the estimates are the truth with
+/// ±1 px uniform noise per coordinate, same ids.
+fn bead_bed(frames: u64) -> (Vec<MotTruth>, Vec<MotEstimate>) {
+    const BED_COLUMNS: usize = 20;
+    const BED_ROWS: usize = 13;
+    const SPACING_PX: f64 = 30.0;
+    const MOVERS: usize = 140;
+    let mut rng = scene::Rng::new(11);
+    let width_px = BED_COLUMNS as f64 * SPACING_PX;
+    let height_px = BED_ROWS as f64 * SPACING_PX * 3f64.sqrt() / 2.0;
+    let movers: Vec<(f64, f64, f64, f64)> = (0..MOVERS)
+        .map(|_| {
+            (
+                rng.unit() * width_px,
+                rng.unit() * height_px,
+                1.0 + 3.0 * rng.unit(),
+                rng.unit() - 0.5,
+            )
+        })
+        .collect();
+    let (mut truth, mut estimates) = (Vec::new(), Vec::new());
+    for frame in 0..frames {
+        let mut discs = Vec::with_capacity(BED_COLUMNS * BED_ROWS + MOVERS);
+        for row in 0..BED_ROWS {
+            for column in 0..BED_COLUMNS {
+                let shift = if row % 2 == 1 { 0.5 } else { 0.0 };
+                let x = (column as f64 + shift) * SPACING_PX + rng.unit() - 0.5;
+                let y = row as f64 * SPACING_PX * 3f64.sqrt() / 2.0 + rng.unit() - 0.5;
+                discs.push((x, y, 15.0));
+            }
+        }
+        for &(x, y, vx, vy) in &movers {
+            let t = frame as f64;
+            let x = (x + vx * t).rem_euclid(width_px);
+            let y = (y + vy * t).rem_euclid(height_px);
+            discs.push((x, y, 10.0));
+        }
+        for (id, &(x, y, radius_px)) in discs.iter().enumerate() {
+            let disc = |x: f64, y: f64| Shape::Disc {
+                centre_px: sillage_core::Point2::new(x, y),
+                radius_px,
+            };
+            truth.push(MotTruth {
+                frame,
+                id: id as u64,
+                shape: disc(x, y),
+                role: TruthRole::Scored,
+            });
+            let (nx, ny) = (2.0 * rng.unit() - 1.0, 2.0 * rng.unit() - 1.0);
+            estimates.push(MotEstimate {
+                frame,
+                id: id as u64,
+                shape: disc(x + nx, y + ny),
+            });
+        }
+    }
+    (truth, estimates)
+}
+
+fn bench_bead_bed(c: &mut Criterion) {
+    let params = MotParams {
+        threshold: 0.43,
+        ..MotParams::default()
+    };
+    let mut group = c.benchmark_group("mot/bead-bed");
+    group.sample_size(10);
+    let frames = 60;
+    let (truth, estimates) = bead_bed(frames);
+    let data = MotData::new(&truth, &estimates, Similarity::DiscIou, None).unwrap();
+    group.throughput(Throughput::Elements(truth.len() as u64));
+    group.bench_with_input(BenchmarkId::new("metrics", frames), &frames, |b, _| {
+        b.iter(|| evaluate_mot(&data, &params).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_tud, bench_synthetic, bench_bead_bed);
 criterion_main!(benches);

@@ -35,3 +35,4 @@ mod summary;
 pub use detection::{DetectionScores, detection_scores};
 pub use mot::{MotData, MotMetrics, MotParams, MotReport, evaluate_mot};
 pub use ptv::{PtvAccuracy, PtvAccuracyParams, ptv_accuracy};
+pub use summary::Table;

@@ -88,7 +88,7 @@ pub(crate) fn family_tables<T>(
 /// A plain-text table: a header row and value rows, columns right-aligned to their widest
 /// cell (the first column left-aligned).
 #[derive(Debug, Clone, Default)]
-pub(crate) struct Table {
+pub struct Table {
     rows: Vec<Vec<String>>,
 }
 

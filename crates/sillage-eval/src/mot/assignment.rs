@@ -2,8 +2,20 @@
 //! for Identity): the candidates split into connected components, each solved by the
 //! dense assignment solver of `sillage-assoc`. Typical frames have many tiny components,
 //! so matching costs about linear time in the number of objects.
+//!
+//! A large component with few candidates per object (a packed bed of discs whose
+//! neighbours overlap slightly) is solved by the sparse solver instead, in time that grows
+//! with its candidates rather than cubically with its objects. When its optimum is not the
+//! only one (a tie, or a near tie within ~10⁻⁹ × the largest value), the component is
+//! re-solved densely, so that the result, tie-breaking included, is always the dense
+//! solver's.
 
-use sillage_assoc::LapSolver;
+use sillage_assoc::sparse_lap::MAX_ABS_COST;
+use sillage_assoc::{LapSolver, Pairing, SparseLapSolver};
+
+/// Components of at most this many rows × columns are solved densely (the dense solver is
+/// about as fast there, and needs no tie check).
+const DENSE_MAX_CELLS: usize = 256;
 
 /// Marks "none" in index buffers.
 const NONE: u32 = u32::MAX;
@@ -31,6 +43,7 @@ pub(crate) enum Objective {
 #[derive(Debug, Default)]
 pub(crate) struct Matcher {
     lap: LapSolver,
+    sparse: SparseLapSolver,
     /// Union-find parent over rows, then columns.
     parent: Vec<u32>,
     /// Component of each edge, then the edges sorted by component.
@@ -43,6 +56,13 @@ pub(crate) struct Matcher {
     cols: Vec<u32>,
     costs: Vec<f64>,
     edge_at: Vec<u32>,
+    /// The component row by row for the sparse solver: offsets, local columns, edges.
+    row_start: Vec<usize>,
+    sparse_cols: Vec<u32>,
+    sparse_edges: Vec<u32>,
+    /// Tests only: solve every component densely (the reference of the sparse path).
+    #[cfg(test)]
+    dense_only: bool,
 }
 
 impl Matcher {
@@ -143,6 +163,16 @@ impl Matcher {
             self.local[n_rows + c as usize] = k as u32;
         }
         let (r, c) = (self.rows.len(), self.cols.len());
+        #[cfg(test)]
+        let sparse_allowed = !self.dense_only;
+        #[cfg(not(test))]
+        let sparse_allowed = true;
+        if sparse_allowed
+            && r * c > DENSE_MAX_CELLS
+            && self.solve_sparse(n_rows, span.clone(), edges, objective, matched)
+        {
+            return;
+        }
         let fill = match objective {
             Objective::MaxWeight => 0.0,
             Objective::MaxPairsMinCost => f64::INFINITY,
@@ -170,6 +200,85 @@ impl Matcher {
                 }
             }
         }
+    }
+}
+
+impl Matcher {
+    /// Solves the current component (its local indices set) with the sparse solver and
+    /// appends its matches; `false`, appending nothing, when the optimum is not unique (or a
+    /// value is outside the sparse solver's domain), for the dense solver to decide.
+    fn solve_sparse(
+        &mut self,
+        n_rows: usize,
+        span: std::ops::Range<usize>,
+        edges: &[Edge],
+        objective: Objective,
+        matched: &mut Vec<usize>,
+    ) -> bool {
+        let component = &self.order[span];
+        // Dense MaxWeight may assign a pair of value ≤ 0 where its 0-fill would do as well.
+        let valid = |v: f64| match objective {
+            Objective::MaxWeight => v > 0.0 && v <= MAX_ABS_COST,
+            Objective::MaxPairsMinCost => v.abs() <= MAX_ABS_COST,
+        };
+        if !component.iter().all(|&e| valid(edges[e as usize].value)) {
+            return false;
+        }
+        // Counting sort of the component's edges by local row (then by edge index).
+        let r = self.rows.len();
+        self.row_start.clear();
+        self.row_start.resize(r + 1, 0);
+        for &e in component {
+            self.row_start[self.local[edges[e as usize].row as usize] as usize + 1] += 1;
+        }
+        for i in 0..r {
+            self.row_start[i + 1] += self.row_start[i];
+        }
+        self.sparse_cols.clear();
+        self.sparse_cols.resize(component.len(), 0);
+        self.costs.clear();
+        self.costs.resize(component.len(), 0.0);
+        self.sparse_edges.clear();
+        self.sparse_edges.resize(component.len(), 0);
+        for &e in component {
+            let edge = edges[e as usize];
+            let slot = &mut self.row_start[self.local[edge.row as usize] as usize];
+            let k = *slot;
+            *slot += 1;
+            self.sparse_cols[k] = self.local[n_rows + edge.col as usize];
+            self.costs[k] = match objective {
+                Objective::MaxWeight => -edge.value,
+                Objective::MaxPairsMinCost => edge.value,
+            };
+            self.sparse_edges[k] = e;
+        }
+        // The fill moved every offset one row on: shift back.
+        self.row_start.copy_within(0..r, 1);
+        self.row_start[0] = 0;
+        let pairing = match objective {
+            Objective::MaxWeight => Pairing::Optional,
+            Objective::MaxPairsMinCost => Pairing::Maximum,
+        };
+        let _ = self.sparse.solve(
+            r,
+            self.cols.len(),
+            &self.row_start,
+            &self.sparse_cols,
+            &self.costs,
+            pairing,
+        );
+        if !self.sparse.is_unique() {
+            return false;
+        }
+        for (i, col) in self.sparse.assignment().iter().enumerate() {
+            if let Some(j) = *col {
+                let k = (self.row_start[i]..self.row_start[i + 1])
+                    .find(|&k| self.sparse_cols[k] as usize == j)
+                    .expect("the sparse solver assigns listed entries only");
+                matched.push(self.sparse_edges[k] as usize);
+            }
+        }
+        true
     }
 }
 
@@ -274,6 +383,74 @@ mod tests {
                     (total - value).abs() < 1e-9,
                     "seed {seed}: {total} vs {value}"
                 );
+            }
+        }
+    }
+
+    /// Edges of a jittered lattice of `side × side` discs seen twice (truth, estimates),
+    /// each object a candidate of the nearby ones: one large sparse component. Values are
+    /// real (`levels == 0`) or among `levels` values (ties); a few objects are missing.
+    fn lattice(seed: u64, side: u32, levels: u64) -> (usize, usize, Vec<Edge>) {
+        let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut unit = move || (next() >> 11) as f64 / (1u64 << 53) as f64;
+        let n = (side * side) as usize;
+        let place = |k: u32, unit: &mut dyn FnMut() -> f64| {
+            let (x, y) = (f64::from(k % side), f64::from(k / side));
+            (x + 0.3 * unit(), y + 0.3 * unit())
+        };
+        let truth: Vec<_> = (0..side * side).map(|k| place(k, &mut unit)).collect();
+        let estimates: Vec<_> = (0..side * side).map(|k| place(k, &mut unit)).collect();
+        let mut edges = Vec::new();
+        for (i, a) in truth.iter().enumerate() {
+            for (j, b) in estimates.iter().enumerate() {
+                let d = ((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt();
+                if d < 1.25 && unit() > 0.03 {
+                    let value = if levels == 0 {
+                        (1.3 - d) * (0.5 + unit())
+                    } else {
+                        (1 + (unit() * levels as f64) as u64) as f64 / levels as f64
+                    };
+                    edges.push(edge(i as u32, j as u32, value));
+                }
+            }
+        }
+        (n, n, edges)
+    }
+
+    #[test]
+    fn large_components_match_the_dense_solver_exactly() {
+        let (mut sparse, mut dense) = (Matcher::default(), Matcher::default());
+        dense.dense_only = true;
+        let (mut got, mut want) = (Vec::new(), Vec::new());
+        for seed in 0..80 {
+            let side = [6, 9, 12, 17][seed as usize % 4];
+            let levels = [0, 0, 3, 1000][seed as usize / 4 % 4];
+            let (rows, cols, edges) = lattice(seed, side, levels);
+            // Rectangular too: drop the last row and two columns' edges.
+            let shapes = [
+                (rows, cols, edges.clone()),
+                (
+                    rows - 1,
+                    cols - 2,
+                    edges
+                        .iter()
+                        .copied()
+                        .filter(|e| (e.row as usize) < rows - 1 && (e.col as usize) < cols - 2)
+                        .collect(),
+                ),
+            ];
+            for (rows, cols, edges) in &shapes {
+                for objective in [Objective::MaxWeight, Objective::MaxPairsMinCost] {
+                    sparse.solve(*rows, *cols, edges, objective, &mut got);
+                    dense.solve(*rows, *cols, edges, objective, &mut want);
+                    assert_eq!(got, want, "seed {seed}, {rows}×{cols}, {objective:?}");
+                }
             }
         }
     }
