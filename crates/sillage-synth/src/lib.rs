@@ -7,7 +7,8 @@
 //! - [`bedload`]: beads resting, rolling and saltating over a packed bed, with motion states
 //!   (MMPF+ paper §3.5.1, §4.2), and detections made from them with misses, bursts of
 //!   misses, false positives and the detector-confidence candidates of Eq. (1)
-//!   ([`BedloadScene`], [`BeadDetectionModel`], [`BedloadSequence`]).
+//!   ([`BedloadScene`], [`BeadDetectionModel`], [`BedloadSequence`]), and its frames rendered
+//!   as backlit grey images like the paper's ([`BedloadRenderer`]).
 //! - [`render_spots`]: Gaussian spots plus uniform or Gaussian noise, for any test or bench
 //!   that needs an image with known centres.
 //!
@@ -32,9 +33,9 @@ mod render;
 pub mod vortex;
 
 pub use bedload::{
-    BeadDetectionModel, BedloadDetectionParams, BedloadFrame, BedloadObservation, BedloadSample,
-    BedloadScene, BedloadSceneParams, BedloadSequence, MissCause, MissedBead, TrueBead,
-    generate_bedload,
+    BeadDetectionModel, BedloadDetectionParams, BedloadFrame, BedloadObservation,
+    BedloadRenderParams, BedloadRenderer, BedloadSample, BedloadScene, BedloadSceneParams,
+    BedloadSequence, MissCause, MissedBead, TrueBead, generate_bedload, render_bedload_frame,
 };
 
 pub use noise::{Noise, NoiseKind};

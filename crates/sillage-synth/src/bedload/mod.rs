@@ -14,6 +14,9 @@
 //!   classes and the candidates `D` of Eq. (1), with the true bead behind each
 //!   ([`BedloadObservation`]).
 //! - [`BedloadSequence`] streams both; [`generate_bedload`] collects a short sequence.
+//! - [`BedloadRenderer`] ([`BedloadRenderParams`], [`render_bedload_frame`]): the frames
+//!   themselves, backlit grey images that look like the paper's (black discs, faint dark
+//!   rims of transparent beads, noise), for running the real bead detector on the scene.
 //!
 //! Coordinates are px, y down (the bed at large y, gravity towards +y), velocities
 //! px/frame. The same parameters give the same frames; the truth draws from its own
@@ -41,11 +44,13 @@ mod detection_params;
 mod detections;
 mod motion;
 mod params;
+mod render;
 mod scene;
 mod sequence;
 
 pub use detection_params::BedloadDetectionParams;
 pub use detections::{BeadDetectionModel, BedloadObservation, MissCause, MissedBead};
 pub use params::BedloadSceneParams;
+pub use render::{BedloadRenderParams, BedloadRenderer, render_bedload_frame};
 pub use scene::{BedloadFrame, BedloadScene, TrueBead};
 pub use sequence::{BedloadSample, BedloadSequence, generate_bedload};
