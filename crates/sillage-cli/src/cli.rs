@@ -401,6 +401,33 @@ pub struct DemoArgs {
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Another demo than the PTV one.
+    #[command(subcommand)]
+    pub kind: Option<DemoKind>,
+}
+
+/// `sillage demo <kind>`.
+#[derive(Debug, Subcommand)]
+pub enum DemoKind {
+    /// Synthetic bedload frames rendered to PNG, beads detected, tracked with MMPF+, scored.
+    Bedload(DemoBedloadArgs),
+}
+
+/// `sillage demo bedload`.
+#[derive(Debug, Args)]
+pub struct DemoBedloadArgs {
+    /// Output folder for frames, truth and tracks.
+    #[arg(long, short, default_value = "out/demo_bedload", value_name = "DIR")]
+    pub out: PathBuf,
+    /// Number of frames.
+    #[arg(long, default_value_t = 100)]
+    pub frames: usize,
+    /// Random seed (scene and particles).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `sillage bench <kind>`.

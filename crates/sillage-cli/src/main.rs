@@ -7,6 +7,7 @@ mod bench;
 mod bench_bedload;
 mod cli;
 mod demo;
+mod demo_bedload;
 mod detect;
 mod eval;
 mod eval_inputs;
@@ -28,7 +29,10 @@ fn main() {
         cli::Command::Synth(cli::SynthCommand::Bedload(a)) => synth_bedload::run_bedload(&a),
         cli::Command::Eval(cli::EvalCommand::Ptv(a)) => eval::run_ptv(&a),
         cli::Command::Eval(cli::EvalCommand::Mot(a)) => eval_mot::run(&a),
-        cli::Command::Demo(a) => demo::run(&a),
+        cli::Command::Demo(a) => match &a.kind {
+            Some(cli::DemoKind::Bedload(b)) => demo_bedload::run(b),
+            None => demo::run(&a),
+        },
         cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
         cli::Command::Bench(cli::BenchCommand::Bedload(a)) => bench_bedload::run(&a),
         cli::Command::Config(a) => ptv::print_config(&a),
