@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::Result;
 use serde::Serialize;
 use sillage::bedload::{BeadFrame, bedload_table};
-use sillage::core::{BLACK_BEAD_CLASS, TRANSPARENT_BEAD_CLASS, TrackPoint};
+use sillage::core::TrackPoint;
 use sillage::detect::BeadDetections;
 use sillage::eval::Table;
 use sillage::eval::papers::BeadTrackScores;
@@ -60,15 +60,8 @@ fn real_truth(dir: &Path) -> Result<(Vec<TrackPoint>, Vec<f64>)> {
         sequence.radius_px(BeadCategory::Transparent),
     ];
     let truth = read_bead_csv(dir.join("ground_truth").join("trackdatatruth.csv"))?
-        .into_iter()
-        .map(|b| TrackPoint {
-            class: match b.category {
-                BeadCategory::Black => BLACK_BEAD_CLASS,
-                BeadCategory::Transparent => TRANSPARENT_BEAD_CLASS,
-            },
-            motion_state: b.motion_state,
-            ..TrackPoint::at(b.frame, b.id, b.pos_px)
-        })
+        .iter()
+        .map(|b| b.track_point())
         .collect();
     Ok((truth, radii))
 }

@@ -9,7 +9,10 @@
 
 use std::path::Path;
 
-use sillage_core::{Error, FrameIndex, MotionState, Point2, Result, Vec2};
+use sillage_core::{
+    BLACK_BEAD_CLASS, Error, FrameIndex, MotionState, Point2, Result, TRANSPARENT_BEAD_CLASS,
+    TrackPoint, Vec2,
+};
 
 use crate::text_table::CsvTable;
 
@@ -40,6 +43,23 @@ pub struct BeadPoint {
     pub vel_px_per_frame: Option<Vec2>,
     /// Motion state (`0` resting, `1` rolling, `2` saltating, `3` or absent: unknown).
     pub motion_state: MotionState,
+}
+
+impl BeadPoint {
+    /// The point as a track point: `id` as the track id, the category as the class
+    /// (`BLACK_BEAD_CLASS`, `TRANSPARENT_BEAD_CLASS`), velocity and motion state kept — the
+    /// form trackers emit and `score_bead_tracks` compares.
+    pub fn track_point(&self) -> TrackPoint {
+        TrackPoint {
+            class: match self.category {
+                BeadCategory::Black => BLACK_BEAD_CLASS,
+                BeadCategory::Transparent => TRANSPARENT_BEAD_CLASS,
+            },
+            vel_px_per_frame: self.vel_px_per_frame,
+            motion_state: self.motion_state,
+            ..TrackPoint::at(self.frame, self.id, self.pos_px)
+        }
+    }
 }
 
 /// Reads a BeadTracking ground-truth CSV (header [`BEAD_HEADER`]; `vx`, `vy` and

@@ -27,6 +27,38 @@ pub struct BeadTrackScores {
     pub states: MotionStateScores,
 }
 
+impl std::fmt::Display for BeadTrackScores {
+    /// One line: Table 1's scores, IDF1, HOTA and the motion-state F-scores.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (t, clear) = (&self.table1, &self.mot.clear);
+        let state_f = |i: usize| {
+            self.states.by_state()[i]
+                .1
+                .f_score
+                .map_or("–".to_string(), |v| format!("{v:.2}"))
+        };
+        write!(
+            f,
+            "correct tracks {:.1} % ({}/{}), MOTA {:.2} %, MOTP {:.2} %, FN {:.2} %, FP {:.2} %, \
+             IDSW {}, IDF1 {:.3}, HOTA {:.3}, state F rest/roll/salt {}/{}/{} over {}",
+            100.0 * t.correct_track_rate,
+            t.correct_tracks,
+            t.truth_tracks,
+            100.0 * clear.mota,
+            100.0 * clear.motp,
+            100.0 * t.false_negative_rate,
+            100.0 * t.false_positive_rate,
+            t.id_switches,
+            self.mot.identity.idf1,
+            self.mot.hota.hota,
+            state_f(0),
+            state_f(1),
+            state_f(2),
+            self.states.evaluated,
+        )
+    }
+}
+
 /// Scores `tracks` against `truth` (both as points with their class and motion state; the
 /// truth's `track_id` is the bead id); a bead of class `c` is a disc of radius
 /// `radius_px[c]` (the last radius for classes beyond the list).
@@ -106,6 +138,10 @@ mod tests {
             .collect();
         let s = score_bead_tracks(&truth, &tracks, &[15.0, 10.0]).unwrap();
         assert_eq!(s.mot.clear.mota, 1.0);
+        assert!(
+            s.to_string()
+                .starts_with("correct tracks 100.0 % (2/2), MOTA 100.00 %")
+        );
         assert_eq!(s.table1.correct_tracks, 2);
         assert_eq!(s.states.evaluated, 20);
         // Two radius-10 discs 9 px apart have IoU < 0.43: the transparent bead is missed.
