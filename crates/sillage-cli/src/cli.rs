@@ -425,6 +425,9 @@ pub struct DemoBedloadArgs {
     /// Random seed (scene and particles).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Also draw every frame with its detections and track tails into OUT/overlays.
+    #[arg(long)]
+    pub overlays: bool,
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -435,8 +438,9 @@ pub struct DemoBedloadArgs {
 pub enum BenchCommand {
     /// Detection and tracking time per frame on synthetic vortex frames.
     Ptv(BenchPtvArgs),
-    /// Table 1 of the MMPF+ paper: the five bedload trackers scored on a synthetic sequence
-    /// and, with --real, on a real one with the τ_t sweep of Fig. 6.
+    /// The MMPF+ paper's evaluation: Table 1 (the five bedload trackers) and the τ_t sweep of
+    /// Fig. 6 on a rendered synthetic sequence and, with --real, on a real one; --plots draws
+    /// Figs. 6 and 7.
     Bedload(BenchBedloadArgs),
 }
 
@@ -456,6 +460,13 @@ pub struct BenchBedloadArgs {
     /// The detector, for --real.
     #[command(flatten)]
     pub detector: BeadDetectorArgs,
+    /// The τ_t values of the Fig. 6 sweep, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [0.15, 0.17, 0.19, 0.21, 0.23, 0.25, 0.27, 0.29, 0.31, 0.33, 0.35])]
+    pub thresholds: Vec<f64>,
+    /// Draw Fig. 6 (correct tracks and MOTA of transparent beads against τ_t) and Fig. 7
+    /// (motion-state F-scores) into this folder, as PNG and SVG.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
     /// Print the rows as JSON.
     #[arg(long)]
     pub json: bool,
@@ -585,6 +596,13 @@ pub struct TrackBedloadArgs {
     /// The detector, when tracking frames.
     #[command(flatten)]
     pub detector: BeadDetectorArgs,
+    /// Also draw every frame with its detections and track tails (coloured by motion state,
+    /// with ids) into this folder, as `overlay_NNNNN.png`.
+    #[arg(long, value_name = "DIR", requires = "input")]
+    pub overlay: Option<PathBuf>,
+    /// Frames of history in each overlay tail.
+    #[arg(long, value_name = "FRAMES", default_value_t = 20)]
+    pub overlay_tail: u64,
     /// Print a machine-readable summary on stdout.
     #[arg(long)]
     pub json: bool,

@@ -15,12 +15,49 @@ use sillage::io::{
 };
 use sillage::synth::{BedloadRenderParams, BedloadRenderer, BedloadScene, BedloadSceneParams};
 use sillage::track::bedload::{BedloadTracker, BedloadTrackerParams};
+use sillage::viz::OverlayStyle;
 
 use crate::cli::DemoBedloadArgs;
+use crate::overlay::{DetectionsByFrame, write_overlays};
 use crate::progress::FrameProgress;
 
 /// Scale of the synthetic sequence (the authors' example), m/px.
 const M_PER_PX: f64 = 2.056e-4;
+
+/// The bead radius of each class of a generated scene (black, transparent), px.
+pub fn synthetic_radii(scene: &BedloadSceneParams) -> [f64; 2] {
+    [scene.black_radius_px, scene.transparent_radius_px]
+}
+
+/// The sequence parameters of a generated scene, as BeadTracking writes them.
+fn synthetic_sequence_params(scene: &BedloadSceneParams) -> BeadSequenceParams {
+    let radii = synthetic_radii(scene);
+    BeadSequenceParams {
+        black_diameter_m: 2.0 * radii[0] * M_PER_PX,
+        transparent_diameter_m: 2.0 * radii[1] * M_PER_PX,
+        m_per_px: M_PER_PX,
+    }
+}
+
+/// The bead detector with its default (real-frame) parameters at the scene's sizes; the
+/// transparent beads and the candidates above `transparent_threshold` when given.
+pub fn synthetic_detector(
+    scene: &BedloadSceneParams,
+    transparent_threshold: Option<f64>,
+) -> Result<BeadDetector> {
+    let sequence = synthetic_sequence_params(scene);
+    let mut params = BeadParams {
+        m_per_px: sequence.m_per_px,
+        black_diameter_m: sequence.black_diameter_m,
+        transparent_diameter_m: sequence.transparent_diameter_m,
+        ..BeadParams::default()
+    };
+    if let Some(threshold) = transparent_threshold {
+        params.transparent_threshold = threshold;
+        params.candidate_threshold = threshold;
+    }
+    Ok(BeadDetector::new(params)?)
+}
 
 /// The demo's summary.
 #[derive(Serialize)]
@@ -52,16 +89,11 @@ pub fn run(args: &DemoBedloadArgs) -> Result<()> {
         scene_params.height,
         frames_dir.display()
     );
-    let radii = [
-        scene_params.black_radius_px,
-        scene_params.transparent_radius_px,
-    ];
-    let sequence = BeadSequenceParams {
-        black_diameter_m: 2.0 * radii[0] * M_PER_PX,
-        transparent_diameter_m: 2.0 * radii[1] * M_PER_PX,
-        m_per_px: M_PER_PX,
-    };
-    write_bead_sequence_params(args.out.join("sequence_param.txt"), &sequence)?;
+    let radii = synthetic_radii(&scene_params);
+    write_bead_sequence_params(
+        args.out.join("sequence_param.txt"),
+        &synthetic_sequence_params(&scene_params),
+    )?;
     let mut renderer = BedloadRenderer::new(BedloadRenderParams::default())?;
     let mut image = GrayImage::new(scene_params.width, scene_params.height);
     let mut truth_writer = BeadCsvWriter::create(args.out.join("truth.csv"))?;
@@ -82,12 +114,7 @@ pub fn run(args: &DemoBedloadArgs) -> Result<()> {
     truth_writer.finish()?;
 
     eprintln!("2/3 detecting the beads in the PNG frames and tracking them with MMPF+");
-    let mut detector = BeadDetector::new(BeadParams {
-        m_per_px: M_PER_PX,
-        black_diameter_m: sequence.black_diameter_m,
-        transparent_diameter_m: sequence.transparent_diameter_m,
-        ..BeadParams::default()
-    })?;
+    let mut detector = synthetic_detector(&scene_params, None)?;
     let params = BedloadTrackerParams {
         radius_px: radii.to_vec(),
         seed: args.seed,
@@ -101,6 +128,7 @@ pub fn run(args: &DemoBedloadArgs) -> Result<()> {
     let mut progress = FrameProgress::new(frames.len(), "tracking");
     let mut beads = BeadDetections::default();
     let mut detections = Vec::new();
+    let mut kept = DetectionsByFrame::new();
     let (mut detect_s, mut track_s) = (0.0, 0.0);
     for frame in frames {
         let frame = frame?;
@@ -110,6 +138,9 @@ pub fn run(args: &DemoBedloadArgs) -> Result<()> {
         detections.clear();
         detections.extend_from_slice(&beads.black);
         detections.extend_from_slice(&beads.transparent);
+        if args.overlays {
+            kept.insert(frame.index, detections.clone());
+        }
         let observations = sillage::core::FrameObservations {
             candidates: &beads.candidates,
             ..sillage::core::FrameObservations::from_detections(frame.index, &detections)
@@ -122,8 +153,25 @@ pub fn run(args: &DemoBedloadArgs) -> Result<()> {
         progress.tick();
     }
     progress.finish();
+    // Points the tracker held back (predictions through misses) are flushed at the end.
+    let n_stepped = tracks.len();
     tracker.finish(&mut tracks)?;
+    writer.accept(&tracks[n_stepped..])?;
     writer.finish()?;
+    if args.overlays {
+        let dir = args.out.join("overlays");
+        let style = OverlayStyle {
+            detection_radius_px: radii.to_vec(),
+            ..OverlayStyle::default()
+        };
+        write_overlays(
+            &frames_dir.to_string_lossy(),
+            &dir,
+            &kept,
+            tracks.clone(),
+            &style,
+        )?;
+    }
 
     eprintln!("3/3 scoring against the truth (disc IoU ≥ 0.43, MMPF+ paper §5.3)");
     let scores = score_bead_tracks(&truth, &tracks, &radii)?;

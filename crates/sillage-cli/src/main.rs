@@ -5,6 +5,7 @@
 
 mod bench;
 mod bench_bedload;
+mod bench_bedload_plots;
 mod cli;
 mod demo;
 mod demo_bedload;
@@ -13,6 +14,7 @@ mod eval;
 mod eval_inputs;
 mod eval_mot;
 mod fit;
+mod overlay;
 mod progress;
 mod ptv;
 mod synth;

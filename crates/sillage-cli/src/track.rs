@@ -9,12 +9,14 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use sillage::core::{Detection, FrameIndex, FrameObservations, Tracker};
 use sillage::detect::BeadDetections;
-use sillage::io::{BeadCsvWriter, FrameOptions, open_frames, read_detections_csv};
+use sillage::io::{BeadCsvWriter, FrameOptions, open_frames, read_bead_csv, read_detections_csv};
 use sillage::toml_config::{read_toml_file, set_key};
 use sillage::track::bedload::{BedloadTracker, BedloadTrackerParams};
+use sillage::viz::OverlayStyle;
 
 use crate::cli::TrackBedloadArgs;
 use crate::detect::{build_detector, detect_frame};
+use crate::overlay::{DetectionsByFrame, write_overlays};
 use crate::progress::FrameProgress;
 
 /// Defaults, then `--config`, then `--set`, then `--tracker` and `--seed`; validated.
@@ -126,10 +128,14 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     let start = Instant::now();
     let mut outcome = Ok(());
     let (mut n_detections, mut n_candidates) = (0, 0);
+    let mut kept = DetectionsByFrame::new();
     for input in frames {
         let step = input.and_then(|(frame, detections, candidates)| {
             n_detections += detections.len();
             n_candidates += candidates.len();
+            if args.overlay.is_some() {
+                kept.insert(frame, detections.clone());
+            }
             let observations = FrameObservations {
                 candidates: &candidates,
                 ..FrameObservations::from_detections(frame, &detections)
@@ -155,6 +161,19 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
         (None, None) => String::new(),
     };
     outcome.with_context(|| format!("while tracking {source}"))?;
+    if let (Some(dir), Some(input)) = (&args.overlay, &args.input) {
+        let tracks = read_bead_csv(&written.path)?
+            .iter()
+            .map(|b| b.track_point())
+            .collect();
+        let style = OverlayStyle {
+            tail_frames: args.overlay_tail,
+            detection_radius_px: params.radius_px.clone(),
+            ..OverlayStyle::default()
+        };
+        let n = write_overlays(input, dir, &kept, tracks, &style)?;
+        eprintln!("{n} overlays → {}", dir.display());
+    }
     let stats = tracker.stats();
     let summary = TrackSummary {
         tracker: params.tracker.name(),

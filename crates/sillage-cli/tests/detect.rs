@@ -114,6 +114,7 @@ fn bad_detector_input_is_a_clear_error() {
 fn track_bedload_detects_frames_itself() {
     let dir = tempfile::tempdir().unwrap();
     let tracks = dir.path().join("tracks.csv");
+    let overlays = dir.path().join("overlays");
     let output = sillage(&[
         "track",
         "bedload",
@@ -124,6 +125,10 @@ fn track_bedload_detects_frames_itself() {
         MASK,
         "--out",
         path_str(&tracks),
+        "--overlay",
+        path_str(&overlays),
+        "--overlay-tail",
+        "5",
         "--json",
     ]);
     assert!(output.status.success(), "{}", stderr(&output));
@@ -132,6 +137,20 @@ fn track_bedload_detects_frames_itself() {
     let tracks_found = summary["tracks"].as_u64().unwrap();
     // 397 true beads in the ten frames.
     assert!((390..=405).contains(&tracks_found), "{summary}");
+    // One overlay per frame, the frame's size, with the beads' heads in their state's
+    // colour: mostly resting, some rolling or saltating.
+    assert_eq!(std::fs::read_dir(&overlays).unwrap().count(), 10);
+    let last = image::open(overlays.join("overlay_00009.png"))
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(last.dimensions(), (1280, 320));
+    let count = |state| {
+        let rgb = sillage::viz::state_rgb(state);
+        last.pixels().filter(|p| p.0 == rgb).count()
+    };
+    use sillage::core::MotionState::{Resting, Rolling, Saltating};
+    assert!(count(Resting) > 300 * 9, "resting {}", count(Resting));
+    assert!(count(Rolling) + count(Saltating) > 20);
     let output = sillage(&["track", "bedload", "--out", path_str(&tracks)]);
     assert_eq!(
         output.status.code(),

@@ -268,20 +268,49 @@ fn synthetic_sequence_to_tracks_to_scores() {
 }
 
 #[test]
-fn bench_bedload_prints_table1_for_the_five_trackers() {
-    let output = sillage(&["bench", "bedload", "--frames", "15", "--json"]);
+fn bench_bedload_prints_table1_and_the_sweep_and_draws_the_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let plots = dir.path().join("plots");
+    let output = sillage(&[
+        "bench",
+        "bedload",
+        "--frames",
+        "8",
+        "--thresholds",
+        "0.2,0.3",
+        "--plots",
+        path_str(&plots),
+        "--json",
+    ]);
     assert!(output.status.success(), "{}", stderr(&output));
     let rows: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     let rows = rows.as_array().unwrap();
-    let trackers: Vec<_> = rows
-        .iter()
-        .map(|r| r["tracker"].as_str().unwrap())
-        .collect();
+    // Table 1 (every bead at τ_t = 0.25), then the sweep (transparent beads), five trackers each.
+    assert_eq!(rows.len(), 15);
+    let field = |row: &serde_json::Value, key: &str| row[key].as_str().unwrap().to_string();
+    let trackers: Vec<_> = rows[..5].iter().map(|r| field(r, "tracker")).collect();
     assert_eq!(trackers, ["mmpf_plus", "mmpf", "pf", "imm", "det"]);
+    assert!(rows[..5].iter().all(|r| field(r, "scope") == "all_beads"));
+    assert!(rows[5..].iter().all(|r| field(r, "scope") == "transparent"));
+    let taus: Vec<f64> = rows[5..]
+        .iter()
+        .map(|r| r["transparent_threshold"].as_f64().unwrap())
+        .collect();
+    assert_eq!(taus, [[0.2; 5], [0.3; 5]].concat());
     for row in rows {
         let mota = find(&row["scores"], "mota").unwrap();
-        assert!(mota > 0.9 && mota <= 1.0, "{row}");
+        assert!(mota <= 1.0, "{row}");
     }
+    // One panel (no real sequence) per figure, PNG and SVG.
+    for name in ["fig6_tau_sweep", "fig7_state_f_scores"] {
+        let png = image::open(plots.join(format!("{name}.png"))).unwrap();
+        assert_eq!((png.width(), png.height()), (760, 460), "{name}");
+        let svg = std::fs::read_to_string(plots.join(format!("{name}.svg"))).unwrap();
+        assert!(svg.contains("MMPF+") && svg.contains("synthetic"), "{name}");
+    }
+    let bad = sillage(&["bench", "bedload", "--frames", "2", "--thresholds", "1.5"]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(stderr(&bad).contains("between 0 and 1"), "{}", stderr(&bad));
 }
 
 #[test]
@@ -295,6 +324,7 @@ fn demo_bedload_renders_detects_tracks_and_scores() {
         path_str(&out),
         "--frames",
         "8",
+        "--overlays",
         "--json",
     ]);
     assert!(output.status.success(), "{}", stderr(&output));
@@ -305,6 +335,8 @@ fn demo_bedload_renders_detects_tracks_and_scores() {
         "tracks.csv",
         "sequence_param.txt",
         "frames/frame_00007.png",
+        "overlays/overlay_00000.png",
+        "overlays/overlay_00007.png",
     ] {
         assert!(out.join(file).exists(), "{file}");
     }

@@ -14,6 +14,9 @@ pub struct Image<T> {
 /// are divided by 255, 16-bit by 65535).
 pub type GrayImage = Image<f32>;
 
+/// An 8-bit colour picture (red, green, blue), as charts and overlays are drawn.
+pub type RgbImage = Image<[u8; 3]>;
+
 impl<T: Copy + Default> Image<T> {
     /// A `width × height` image filled with `T::default()`.
     pub fn new(width: usize, height: usize) -> Self {

@@ -75,7 +75,10 @@ pub use beads::{
 pub use detections::{
     DETECTIONS_HEADER, DetectionsCsvWriter, read_detections_csv, write_detections_csv,
 };
-pub use frames::{Frame, FrameOptions, FrameSource, open_frames, read_image, write_png16};
+pub use frames::{
+    Frame, FrameOptions, FrameSource, open_frames, read_image, write_png_rgb, write_png16,
+    write_text,
+};
 pub use matrix::read_matrix_csv;
 pub use mot::{
     MotFileRole, MotResultsWriter, MotRow, MotSequenceFile, SeqInfo, parse_mot_rows, parse_seqinfo,

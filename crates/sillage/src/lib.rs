@@ -35,3 +35,4 @@ pub use sillage_image as image;
 pub use sillage_io as io;
 pub use sillage_synth as synth;
 pub use sillage_track as track;
+pub use sillage_viz as viz;

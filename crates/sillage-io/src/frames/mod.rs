@@ -15,7 +15,7 @@ use crossbeam_channel::{Receiver, Sender};
 use sillage_core::{Error, FrameIndex, GrayImage, Result};
 
 pub use decode::read_image;
-pub use encode::write_png16;
+pub use encode::{write_png_rgb, write_png16, write_text};
 
 use input::InputKind;
 use video::{FfmpegDecoder, VideoInfo};

@@ -43,6 +43,17 @@ impl BedloadTrackerKind {
             Self::Det => "det",
         }
     }
+
+    /// The name the MMPF+ paper prints (Table 1, Figs. 6-7).
+    pub fn paper_name(self) -> &'static str {
+        match self {
+            Self::MmpfPlus => "MMPF+",
+            Self::Mmpf => "MMPF",
+            Self::Pf => "PF",
+            Self::Imm => "IMM",
+            Self::Det => "DET",
+        }
+    }
 }
 
 /// Where the association predicts a tracker before searching detections around it.

@@ -1,0 +1,36 @@
+//! Pictures of the results, as pixels or SVG text (files are written by `sillage-io`):
+//!
+//! - [`Figure`] of [`GroupedChart`]s: categories along x, grouped bars on a left scale and
+//!   curves on a right scale — the MMPF+ paper's Fig. 6 and Fig. 7 — as PNG pixels or SVG;
+//! - [`draw_overlay`]: a frame with its detections circled and track tails coloured by motion
+//!   state, with ids, from a [`TrackHistory`].
+//!
+//! Text uses a built-in typeface (DejaVu Sans), so nothing depends on the system's fonts.
+//!
+//! ```
+//! use sillage_viz::{Figure, GroupedChart, Series, ValueAxis};
+//!
+//! let chart = GroupedChart {
+//!     title: "Motion-state F-score".into(),
+//!     x_label: "state".into(),
+//!     categories: vec!["resting".into(), "rolling".into(), "saltating".into()],
+//!     bar_axis: ValueAxis { label: "F-score".into(), min: 0.0, max: 1.0 },
+//!     bars: vec![Series { label: "MMPF+".into(), values: vec![Some(0.87), Some(0.57), Some(0.9)] }],
+//!     line_axis: None,
+//!     lines: vec![],
+//! };
+//! let picture = Figure { panels: vec![chart] }.to_rgb(480, 320)?;
+//! assert_eq!(picture.dimensions(), (480, 320));
+//! # Ok::<(), sillage_core::Error>(())
+//! ```
+
+mod chart;
+mod font;
+mod history;
+mod overlay;
+mod palette;
+
+pub use chart::{Figure, GroupedChart, Series, ValueAxis};
+pub use history::TrackHistory;
+pub use overlay::{OverlayStyle, draw_overlay};
+pub use palette::state_rgb;
