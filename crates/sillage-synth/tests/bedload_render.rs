@@ -4,68 +4,27 @@
 //!
 //! The issue's acceptance: "the detectors, run with the parameters tuned on the real frames,
 //! reach within 2 points of the same recall" on the generated frames as on the real ones.
-//! - On the bead configurations of the ten real frames (their hand-made ground truth,
-//!   rendered), every class's recall is within 2 points of the real frames', with the
-//!   built-in ring template and with BeadTracking's.
-//! - On the default synthetic scene, the mobile beads overlap one another far more than in the
-//!   real flume (they all move on one surface line and pass through each other), so most
-//!   transparent beads there are hidden: the recall over all beads is far lower than on the
-//!   real frames, which no renderer can change. The comparison is made, within 2 points, on
-//!   the beads whose neighbourhood the real frames also show (no bead closer than the real
-//!   frames' closest pair of the same two classes); the recall over all beads is printed.
+//! Here, on the bead configurations of the ten real frames (their hand-made ground truth,
+//! rendered): every class's recall is within 2 points of the real frames', with the
+//! built-in ring template and with BeadTracking's. On generated sequences:
+//! `bedload_generated.rs`.
 
-use rand::RngExt;
-use sillage_core::{
-    BLACK_BEAD_CLASS, Detection, FrameIndex, GrayImage, MotionState, Point2, TruthPoint, rng_stream,
+mod common;
+
+use common::{
+    DATA, MAX_RECALL_GAP, REAL_RECALL_BUILT_IN, detector, real_configurations, render_and_detect,
+    report, score, truth,
 };
-use sillage_detect::{BeadDetections, BeadDetector, BeadParams};
-use sillage_eval::{DetectionScores, detection_scores};
+use sillage_core::GrayImage;
 use sillage_synth::{
-    BedloadFrame, BedloadRenderParams, BedloadRenderer, BedloadScene, BedloadSceneParams, TrueBead,
+    BedloadFrame, BedloadRenderParams, BedloadRenderer, BedloadScene, BedloadSceneParams,
     render_bedload_frame,
 };
-
-const DATA: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../../shared/data/bedload_beads_lafaye2018"
-);
-
-/// A detection matches a true bead strictly closer than this, px (as the real-frame test).
-const MATCH_RADIUS_PX: f64 = 2.0;
-
-/// The largest gap allowed between the synthetic and the real recall (the issue's 2 points).
-const MAX_RECALL_GAP: f64 = 0.02;
-
-/// Recall of the detector on the ten real frames (`shared/data/bedload_beads_lafaye2018`,
-/// against `ground_truth/trackdatatruth.csv`, within 2 px), measured as
-/// `sillage-detect/tests/bead.rs` does (same parameters, the sequence's base mask) but with
-/// the built-in ring template: black 3188 of 3188, transparent 773 of 774.
-const REAL_RECALL_BUILT_IN: [f64; 2] = [1.0, 773.0 / 774.0];
 
 /// The same with BeadTracking's template (`template_transparent_bead_rOut10_rIn6.csv`):
 /// black 3188 of 3188, transparent 754 of 774 (0.9742), as `cargo test -p sillage-detect
 /// --test bead -- --nocapture` prints. The 20 misses are two resting beads in all ten frames.
 const REAL_RECALL_TEMPLATE: [f64; 2] = [1.0, 754.0 / 774.0];
-
-/// The closest centres in the real frames' ground truth, px, for black–black,
-/// transparent–black and transparent–transparent pairs (26.2, 20.6 and 12.5 measured).
-const REAL_CLOSEST_PX: [f64; 3] = [26.0, 20.5, 12.5];
-
-/// The detector of the real-frame test, without base mask (the synthetic frames have no
-/// flume base) and with the built-in ring template unless `template` is given.
-fn detector(template: Option<&GrayImage>) -> BeadDetector {
-    let params = BeadParams {
-        m_per_px: 2.056e-4,
-        black_diameter_m: 0.006,
-        transparent_diameter_m: 0.004,
-        ..BeadParams::default()
-    };
-    let detector = BeadDetector::new(params).unwrap();
-    match template {
-        Some(template) => detector.with_ring_template(template).unwrap(),
-        None => detector,
-    }
-}
 
 /// BeadTracking's ring template (21×21 values of CSV).
 fn beadtracking_template() -> GrayImage {
@@ -77,127 +36,6 @@ fn beadtracking_template() -> GrayImage {
         .map(|v| v.trim().parse().unwrap())
         .collect();
     GrayImage::from_vec(21, 21, values).unwrap()
-}
-
-/// The ten real frames' ground truth as bedload frames (0-based pixels). Its positions are
-/// whole pixels, so each bead is moved by a uniform offset of up to half a pixel along each
-/// axis (the real centres lie somewhere in that square: the black beads' centroids deviate
-/// from the truth by 0.31 px rms along each axis, as a rounding does).
-fn real_configurations() -> Vec<BedloadFrame> {
-    let path = format!("{DATA}/ground_truth/trackdatatruth.csv");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let mut frames: Vec<BedloadFrame> = (0..10)
-        .map(|index| BedloadFrame {
-            index,
-            beads: Vec::new(),
-        })
-        .collect();
-    let mut rng = rng_stream(2018, 0);
-    for line in text.lines().skip(1) {
-        // frame,id,x,y,category,vx,vy,motion_state; frame and pixels 1-based.
-        let v: Vec<&str> = line.split(',').collect();
-        let frame = v[0].parse::<usize>().unwrap() - 1;
-        let (x, y): (f64, f64) = (v[2].parse().unwrap(), v[3].parse().unwrap());
-        frames[frame].beads.push(TrueBead {
-            track_id: v[1].parse().unwrap(),
-            class: v[4].parse().unwrap(),
-            pos_px: Point2::new(
-                x - 1.0 + rng.random::<f64>() - 0.5,
-                y - 1.0 + rng.random::<f64>() - 0.5,
-            ),
-            vel_px_per_frame: None,
-            motion_state: MotionState::Unknown,
-            in_bed: false,
-        });
-    }
-    frames
-}
-
-/// The beads of one class (0 black, 1 transparent), all or only `admissible` ones, as truth.
-fn truth(frames: &[BedloadFrame], class: u32, admissible: bool) -> Vec<TruthPoint> {
-    frames
-        .iter()
-        .flat_map(|frame| {
-            frame
-                .beads
-                .iter()
-                .filter(move |b| b.class == class)
-                .filter(move |b| !admissible || has_a_real_neighbourhood(frame, b))
-                .map(move |b| TruthPoint {
-                    frame: frame.index,
-                    track_id: b.track_id,
-                    pos_px: b.pos_px,
-                    vel_px_per_frame: None,
-                })
-        })
-        .collect()
-}
-
-/// True when no other bead of the frame is closer to `bead` than the real frames' closest
-/// pair of the same two classes.
-fn has_a_real_neighbourhood(frame: &BedloadFrame, bead: &TrueBead) -> bool {
-    frame.beads.iter().all(|other| {
-        if other.track_id == bead.track_id {
-            return true;
-        }
-        let black = [bead.class, other.class]
-            .iter()
-            .filter(|&&c| c == BLACK_BEAD_CLASS)
-            .count();
-        let closest = REAL_CLOSEST_PX[2 - black];
-        bead.pos_px.distance(other.pos_px) >= closest
-    })
-}
-
-/// Scores the detections of one class (0 black, 1 transparent) against `truth`.
-fn score(
-    truth: &[TruthPoint],
-    per_frame: &[(FrameIndex, BeadDetections)],
-    class: u32,
-) -> DetectionScores {
-    let detections: Vec<(FrameIndex, Vec<Detection>)> = per_frame
-        .iter()
-        .map(|(f, d)| {
-            let list = if class == BLACK_BEAD_CLASS {
-                &d.black
-            } else {
-                &d.transparent
-            };
-            (*f, list.clone())
-        })
-        .collect();
-    detection_scores(truth, &detections, MATCH_RADIUS_PX).unwrap()
-}
-
-/// Renders `frames` and runs `detector` on them.
-fn render_and_detect(
-    frames: &[BedloadFrame],
-    detector: &mut BeadDetector,
-) -> Vec<(FrameIndex, BeadDetections)> {
-    let (width, height) = (1280, 320);
-    let mut renderer = BedloadRenderer::new(BedloadRenderParams::default()).unwrap();
-    let mut image = GrayImage::new(width, height);
-    frames
-        .iter()
-        .map(|frame| {
-            renderer.render(frame, &mut image);
-            let mut beads = BeadDetections::default();
-            detector.detect_beads(&image, &mut beads).unwrap();
-            (frame.index, beads)
-        })
-        .collect()
-}
-
-fn report(label: &str, scores: &DetectionScores) -> f64 {
-    let recall = scores.recall.unwrap();
-    println!(
-        "{label}: recall {recall:.4}, precision {:.4} ({} true, {} matched, {} false)",
-        scores.precision.unwrap_or(f64::NAN),
-        scores.true_positives + scores.false_negatives,
-        scores.true_positives,
-        scores.false_positives
-    );
-    recall
 }
 
 #[test]
@@ -214,7 +52,7 @@ fn rendered_real_configurations_are_as_hard_to_detect_as_the_real_frames() {
     ] {
         let per_frame = render_and_detect(&frames, &mut detector(template));
         for (class, label) in [(0, "black"), (1, "transparent")] {
-            let scores = score(&truth(&frames, class, false), &per_frame, class);
+            let scores = score(&truth(&frames, class, |_, _| true), &per_frame, class);
             let recall = report(&format!("real configurations, {name}, {label}"), &scores);
             assert!(
                 (recall - real[class as usize]).abs() <= MAX_RECALL_GAP,
@@ -222,43 +60,6 @@ fn rendered_real_configurations_are_as_hard_to_detect_as_the_real_frames() {
                 real[class as usize]
             );
         }
-    }
-}
-
-#[test]
-fn default_scene_frames_through_the_detector() {
-    let params = BedloadSceneParams {
-        n_frames: 10,
-        seed: 7,
-        ..BedloadSceneParams::default()
-    };
-    let frames: Vec<BedloadFrame> = BedloadScene::new(params).unwrap().collect();
-    let start = std::time::Instant::now();
-    let per_frame = render_and_detect(&frames, &mut detector(None));
-    println!(
-        "{} frames rendered and detected in {:?}",
-        frames.len(),
-        start.elapsed()
-    );
-    for (class, label) in [(0, "black"), (1, "transparent")] {
-        let all = score(&truth(&frames, class, false), &per_frame, class);
-        report(&format!("default scene, all {label} beads"), &all);
-        // Recall only: the detections of the beads left out count as false positives here.
-        let comparable = truth(&frames, class, true);
-        let recall = score(&comparable, &per_frame, class).recall.unwrap();
-        println!(
-            "default scene, {} {label} beads in real-like neighbourhoods: recall {recall:.4}",
-            comparable.len()
-        );
-        assert!(comparable.len() >= 30, "{label}: too few beads to compare");
-        let real = REAL_RECALL_BUILT_IN[class as usize];
-        assert!(
-            (recall - real).abs() <= MAX_RECALL_GAP,
-            "{label}: synthetic recall {recall:.4}, real {real:.4}"
-        );
-        // Not an easy stand-in: over all beads, the detector does no better than on the real
-        // frames.
-        assert!(all.recall.unwrap() <= real + 1e-9);
     }
 }
 

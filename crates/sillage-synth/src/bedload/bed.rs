@@ -2,7 +2,9 @@
 //! and the surface on which the mobile beads rest, roll and land.
 
 use rand::RngExt;
-use sillage_core::{BLACK_BEAD_CLASS, ObjectClass, Point2, RngStream, Vec2};
+use sillage_core::{
+    BLACK_BEAD_CLASS, ObjectClass, Point2, RngStream, TRANSPARENT_BEAD_CLASS, Vec2,
+};
 
 use super::BedloadSceneParams;
 
@@ -83,8 +85,9 @@ pub(crate) fn disk_offset(rng: &mut RngStream, radius: f64) -> Vec2 {
 }
 
 /// The bed surface for each bead class: the y of the centre of a bead of that class
-/// resting on the bed at a given x, i.e. the upper envelope of the circles of radius
-/// `r_black + r_class` about the bed beads (the flume floor where there is no bed).
+/// resting on the bed at a given x, i.e. the upper envelope of the circles of the contact
+/// distance ([`BedloadSceneParams::contact_distance_px`]) about the bed beads (the flume
+/// floor where there is no bed).
 /// Tabulated exactly every 0.25 px, linear in between (within 0.1 px of the envelope).
 #[derive(Debug, Clone)]
 pub(crate) struct BedSurface {
@@ -95,24 +98,37 @@ pub(crate) struct BedSurface {
 impl BedSurface {
     fn new(params: &BedloadSceneParams, beads: &[Point2]) -> Self {
         let margin = margin_px(params);
-        let x0 = -margin;
         let len = ((params.width as f64 - 1.0 + 2.0 * margin) / SURFACE_STEP_PX).ceil() as usize;
-        let tables = [0, 1].map(|class| {
-            let radius = params.radius_px(class);
-            let reach = params.black_radius_px + radius;
-            let mut table = vec![params.height as f64 - 1.0 - radius; len + 1];
-            for bead in beads {
-                let first = (((bead.x - reach - x0) / SURFACE_STEP_PX).ceil().max(0.0)) as usize;
-                let last = (((bead.x + reach - x0) / SURFACE_STEP_PX).floor()) as usize;
-                for (i, y) in table.iter_mut().enumerate().take(last + 1).skip(first) {
-                    let dx = x0 + i as f64 * SURFACE_STEP_PX - bead.x;
-                    let top = bead.y - (reach * reach - dx * dx).max(0.0).sqrt();
-                    *y = y.min(top);
-                }
+        let tables = [BLACK_BEAD_CLASS, TRANSPARENT_BEAD_CLASS]
+            .map(|class| vec![params.height as f64 - 1.0 - params.radius_px(class); len + 1]);
+        let mut surface = Self {
+            x0: -margin,
+            tables,
+        };
+        for &bead in beads {
+            surface.lay(bead, BLACK_BEAD_CLASS, params);
+        }
+        surface
+    }
+
+    /// Raises the surface over a bead of `class` at `bead`: a bead lying on the surface
+    /// then touches it or lies higher.
+    pub(crate) fn lay(&mut self, bead: Point2, class: ObjectClass, params: &BedloadSceneParams) {
+        let x0 = self.x0;
+        for (table, other) in self
+            .tables
+            .iter_mut()
+            .zip([BLACK_BEAD_CLASS, TRANSPARENT_BEAD_CLASS])
+        {
+            let reach = params.contact_distance_px(class, other);
+            let first = (((bead.x - reach - x0) / SURFACE_STEP_PX).ceil().max(0.0)) as usize;
+            let last = (((bead.x + reach - x0) / SURFACE_STEP_PX).floor()).max(0.0) as usize;
+            for (i, y) in table.iter_mut().enumerate().take(last + 1).skip(first) {
+                let dx = x0 + i as f64 * SURFACE_STEP_PX - bead.x;
+                let top = bead.y - (reach * reach - dx * dx).max(0.0).sqrt();
+                *y = y.min(top);
             }
-            table
-        });
-        Self { x0, tables }
+        }
     }
 
     /// The y of the centre of a bead of `class` resting on the bed at `x` (x beyond the
@@ -160,7 +176,7 @@ impl Bed {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sillage_core::{TRANSPARENT_BEAD_CLASS, rng_stream};
+    use sillage_core::rng_stream;
 
     #[test]
     fn the_surface_touches_the_bed_without_overlapping_it() {
@@ -171,7 +187,7 @@ mod tests {
             .collect();
         let surface = BedSurface::new(&params, &all);
         for class in [BLACK_BEAD_CLASS, TRANSPARENT_BEAD_CLASS] {
-            let reach = params.black_radius_px + params.radius_px(class);
+            let reach = params.contact_distance_px(BLACK_BEAD_CLASS, class);
             for step in 0..=(1279 * 7) {
                 let x = step as f64 / 7.0;
                 let centre = Point2::new(x, surface.y(x, class));
@@ -179,7 +195,7 @@ mod tests {
                     .iter()
                     .map(|bead| bead.distance(centre) - reach)
                     .fold(f64::INFINITY, f64::min);
-                // In contact (the nearest bed bead at the sum of the radii) within the
+                // In contact (the nearest bed bead at the contact distance) within the
                 // linear interpolation's error; never sunk into the bed by more than it.
                 assert!(gap.abs() < 0.1, "x = {x}: gap {gap}");
             }

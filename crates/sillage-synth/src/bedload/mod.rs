@@ -5,11 +5,13 @@
 //!
 //! - [`BedloadScene`] ([`BedloadSceneParams`]): a static bed of black beads in hexagonal layers
 //!   in contact at the bottom of the frame (6 contacts inside the bed, as the motion-state
-//!   rule `nbN ≥ 5` expects), and mobile beads, black and transparent, resting on its
-//!   surface, rolling along it downstream or saltating above it in ballistic hops, their
-//!   states switching per frame by the transition table (default Eq. (11)). Beads leaving
-//!   downstream come back upstream as new identities. Yields [`BedloadFrame`]s of
-//!   [`TrueBead`]s.
+//!   rule `nbN ≥ 5` expects), and mobile beads, black and transparent, resting on it or on
+//!   each other, rolling downstream over it and over lower beads, or saltating above them in
+//!   ballistic hops, their states switching per frame by the transition table (default
+//!   Eq. (11)). The flume being about one bead wide (§4.1), no two beads come closer than
+//!   their contact distance, measured on the real frames
+//!   ([`BedloadSceneParams::contact_factors`]). Beads leaving downstream come back upstream
+//!   as new identities. Yields [`BedloadFrame`]s of [`TrueBead`]s.
 //! - [`BeadDetectionModel`] ([`BedloadDetectionParams`]): per frame, the detections of both
 //!   classes and the candidates `D` of Eq. (1), with the true bead behind each
 //!   ([`BedloadObservation`]).
@@ -44,6 +46,7 @@ mod detection_params;
 mod detections;
 mod motion;
 mod params;
+mod pile;
 mod render;
 mod scene;
 mod sequence;

@@ -1,11 +1,13 @@
-//! One mobile bead: its motion state drawn from the transition table, and a motion that
-//! agrees with it (resting still, rolling along the bed surface, saltating in hops).
+//! One mobile bead: its motion state drawn from the transition table, and the move that
+//! agrees with it (resting still, rolling downstream, saltating in hops), before the
+//! contacts with the other beads ([`super::pile`]) limit it.
 
 use rand::RngExt;
 use sillage_core::{MotionState, ObjectClass, Point2, RngStream, TrackId};
 
 use super::BedloadSceneParams;
-use super::bed::{BedSurface, disk_offset};
+use super::bed::BedSurface;
+use super::pile::{MAX_STEP_PX, Proposal};
 
 /// The motion-state order of the transition table's rows and columns.
 const STATES: [MotionState; 3] = [
@@ -43,22 +45,27 @@ pub(crate) fn uniform(rng: &mut RngStream, [min, max]: [f64; 2]) -> f64 {
     min + (max - min) * rng.random::<f64>()
 }
 
-/// What the motion needs besides the bead: parameters and the bed surface.
+/// What the motion needs besides the bead: parameters, the bed surface and the top of the
+/// pile on it.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Dynamics<'a> {
     /// The scene's parameters.
     pub params: &'a BedloadSceneParams,
-    /// The surface the beads move on.
+    /// The surface of the static bed.
     pub surface: &'a BedSurface,
+    /// The surface of the bed and of the mobile beads that stay on it this frame, as they
+    /// were at its start: what saltating beads fly over.
+    pub top: &'a BedSurface,
 }
 
 impl Dynamics<'_> {
-    fn direction(&self) -> f64 {
+    /// −1 or +1, the sign of x downstream.
+    pub(crate) fn direction(&self) -> f64 {
         f64::from(self.params.flow_direction)
     }
 
     /// The point of the surface at `x` for a bead of `class`.
-    fn on_surface(&self, x: f64, class: ObjectClass) -> Point2 {
+    pub(crate) fn on_surface(&self, x: f64, class: ObjectClass) -> Point2 {
         Point2::new(x, self.surface.y(x, class))
     }
 }
@@ -95,26 +102,27 @@ struct Flight {
     hop: Hop,
 }
 
-/// A mobile bead: rests on the bed surface, rolls along it, or saltates above it.
+/// A mobile bead: rests on the bed or on other beads, rolls over them, or saltates above
+/// them. Its place among the others is settled by [`super::pile::Pile`] every frame.
 #[derive(Debug, Clone)]
 pub(crate) struct Mover {
     /// Identity of the bead.
     pub track_id: TrackId,
     /// Its class.
     pub class: ObjectClass,
-    /// Its true position, px.
-    pub pos: Point2,
+    /// Its place in contact with the others, px (a resting bead is reported off it by its
+    /// jitter).
+    pub anchor: Point2,
     /// The state of its last step.
     pub state: MotionState,
-    /// Where it rests (on the surface), while resting.
-    rest_point: Point2,
     /// Its speed along x while rolling, px/frame.
     rolling_speed: f64,
     flight: Flight,
 }
 
 impl Mover {
-    /// A bead of `class` on the surface at `x`, in `state` (saltating: at a take-off).
+    /// A bead of `class` on the bed surface at `x` in `state`, before its place among the
+    /// others is settled (a saltating one takes off with [`Mover::launch`] once it is).
     pub(crate) fn new(
         track_id: TrackId,
         class: ObjectClass,
@@ -123,83 +131,109 @@ impl Mover {
         dynamics: &Dynamics<'_>,
         rng: &mut RngStream,
     ) -> Self {
-        let pos = dynamics.on_surface(x, class);
-        let mut bead = Self {
+        Self {
             track_id,
             class,
-            pos,
+            anchor: dynamics.on_surface(x, class),
             state,
-            rest_point: pos,
             rolling_speed: uniform(rng, dynamics.params.rolling_speed_px_per_frame),
             flight: Flight::default(),
-        };
-        if state == MotionState::Saltating {
-            bead.launch(dynamics, rng);
         }
-        bead
     }
 
-    /// Moves the bead one frame: a new state from the transition table, then the motion of
-    /// that state (Eq. (3)'s order: state first, then position).
-    ///
-    /// A saltation's number of frames is drawn at its launch from the geometric law the
-    /// table's saltating row implies (`P(K = k) = π_ss^(k−1)(1 − π_ss)`), so the per-frame
-    /// transition frequencies are those of the table; its hops are planned to land on the
-    /// surface exactly on its last frame, and the next state is drawn from the saltating row
-    /// without its saltating entry. Saltating frames that fall on a rebound or the landing
-    /// are on the surface (a one-frame saltation is a hop between two frames).
-    pub(crate) fn step(
-        &mut self,
-        dynamics: &Dynamics<'_>,
+    /// The bead's next state, drawn from the transition table (Eq. (3)'s order: state
+    /// first, then position, see [`Mover::step`]). A saltation's number of frames is drawn
+    /// at its launch from the geometric law the table's saltating row implies (`P(K = k) =
+    /// π_ss^(k−1)(1 − π_ss)`), so the per-frame transition frequencies are those of the
+    /// table; the state after its last frame is drawn from the saltating row without its
+    /// saltating entry.
+    pub(crate) fn next_state(
+        &self,
+        params: &BedloadSceneParams,
         motion: &mut RngStream,
-        jitter: &mut RngStream,
-    ) {
-        let table = &dynamics.params.transition_probabilities;
+    ) -> MotionState {
+        let table = &params.transition_probabilities;
         let u = motion.random::<f64>();
-        let next = match self.state {
+        match self.state {
             MotionState::Saltating if self.flight.frames_left > 0 => MotionState::Saltating,
             MotionState::Saltating => {
                 let row = table[2];
                 draw([row[0], row[1], 0.0], u)
             }
             state => draw(table[index(state)], u),
-        };
-        let was_resting = self.state == MotionState::Resting;
-        if was_resting {
-            self.pos = self.rest_point;
         }
-        match next {
-            MotionState::Resting => {
-                if !was_resting {
-                    self.rest_point = self.pos;
-                }
-                // Kept in the frame by a projection, which cannot lengthen a displacement.
-                let half = dynamics.params.resting_jitter_px / 2.0;
-                let pos = self.rest_point + disk_offset(jitter, half);
-                let last_x = dynamics.params.width as f64 - 1.0;
-                self.pos = Point2::new(pos.x.clamp(0.0, last_x), pos.y);
+    }
+
+    /// A resting bead whose support went away (it took off) falls onto what lies below: it
+    /// is set rolling, at the speed of its last roll.
+    pub(crate) fn fall(&mut self) {
+        if self.state == MotionState::Resting {
+            self.state = MotionState::Rolling;
+        }
+    }
+
+    /// Enters state `next` and returns its move, which the pile then limits by the
+    /// contacts: resting stays put, rolling advances by its speed along x (a `loaded` bead,
+    /// which another lies on, stays put), saltating follows its hop, planned over the pile's top `dynamics.top`
+    /// to land on it exactly on the saltation's last frame (or earlier on a bead that has
+    /// moved in the way, see [`Mover::end_flight_frame`]). A bead whose first hop would
+    /// move it by more than `MAX_STEP_PX` (out of a deep hole) does not take off.
+    pub(crate) fn step(
+        &mut self,
+        next: MotionState,
+        dynamics: &Dynamics<'_>,
+        motion: &mut RngStream,
+        loaded: bool,
+    ) -> Proposal {
+        let mut next = next;
+        if next == MotionState::Saltating && self.state != MotionState::Saltating {
+            self.launch(dynamics, motion);
+            let to = self.fly(dynamics, motion);
+            if to.distance(self.anchor) <= MAX_STEP_PX {
+                self.state = next;
+                return Proposal::Air {
+                    to,
+                    lands: self.flight.frames_left == 0,
+                };
             }
+            // Too deep in a hole between higher beads to leave it but steeply: it stays in
+            // its state (a take-off is 1 % per frame in Eq. (11)).
+            next = self.state;
+        }
+        let proposal = match next {
+            MotionState::Resting => Proposal::Ground { dx: 0.0 },
             MotionState::Rolling => {
                 if self.state != MotionState::Rolling {
                     self.rolling_speed =
                         uniform(motion, dynamics.params.rolling_speed_px_per_frame);
                 }
-                let x = self.pos.x + dynamics.direction() * self.rolling_speed;
-                self.pos = dynamics.on_surface(x, self.class);
+                let dx = if loaded {
+                    0.0
+                } else {
+                    dynamics.direction() * self.rolling_speed
+                };
+                Proposal::Ground { dx }
             }
-            _ => {
-                if self.state != MotionState::Saltating {
-                    self.launch(dynamics, motion);
-                }
-                self.fly(dynamics, motion);
-            }
-        }
+            _ => Proposal::Air {
+                to: self.fly(dynamics, motion),
+                lands: self.flight.frames_left == 0,
+            },
+        };
         self.state = next;
+        proposal
     }
 
-    /// Starts a saltation from the current (surface) position: its horizontal velocity and
-    /// its number of frames.
-    fn launch(&mut self, dynamics: &Dynamics<'_>, rng: &mut RngStream) {
+    /// After a saltating frame: a bead the pile `stopped` on a bead in its way rebounds,
+    /// starting a new hop from there on its next frame (Eq. (3)'s saltating-rebound).
+    pub(crate) fn end_flight_frame(&mut self, stopped: bool) {
+        if stopped {
+            self.flight.hop.elapsed = self.flight.hop.frames;
+        }
+    }
+
+    /// Starts a saltation from the current position: its horizontal velocity and its number
+    /// of frames.
+    pub(crate) fn launch(&mut self, dynamics: &Dynamics<'_>, rng: &mut RngStream) {
         let params = dynamics.params;
         let speed = uniform(rng, params.saltation_speed_px_per_frame);
         let stay = params.transition_probabilities[2][2];
@@ -213,8 +247,8 @@ impl Mover {
             1 + (u.ln() / stay.ln()).floor() as u64
         };
         let hop = Hop {
-            start: self.pos,
-            end: self.pos,
+            start: self.anchor,
+            end: self.anchor,
             ..Hop::default()
         };
         self.flight = Flight {
@@ -224,50 +258,68 @@ impl Mover {
         };
     }
 
-    /// One saltating frame: along the hop under way, a new hop from the surface first when
-    /// the last one has landed.
-    fn fly(&mut self, dynamics: &Dynamics<'_>, rng: &mut RngStream) {
+    /// One saltating frame: the point of the hop under way it aims at, a new hop from the
+    /// current position first when the last one has landed or rebounded.
+    fn fly(&mut self, dynamics: &Dynamics<'_>, rng: &mut RngStream) -> Point2 {
         if self.flight.hop.elapsed >= self.flight.hop.frames {
             self.flight.hop = self.plan_hop(dynamics, rng);
         }
         let hop = &mut self.flight.hop;
         hop.elapsed += 1;
-        self.pos = hop.at(hop.elapsed);
         self.flight.frames_left = self.flight.frames_left.saturating_sub(1);
+        hop.at(hop.elapsed)
     }
 
-    /// A hop from the current surface point: `round(2v/g)` frames for a launch speed `v`
-    /// (at most the saltation's frames left), its gravity raised where needed to keep every
-    /// frame in flight `hop_clearance_px` above the surface; shortened while its apex would
-    /// leave the top of the frame.
+    /// A hop from the current position over the pile's top: `round(2v/g)` frames for a
+    /// launch speed `v`, its gravity raised where needed to keep every frame in flight
+    /// `hop_clearance_px` above the top. Over a pile, a short hop would have to rise and
+    /// fall steeply; of the hops of 1 to 3 times that many frames (at most the saltation's
+    /// frames left) whose apex stays in the frame, the one closest to it that moves by at
+    /// most `MAX_STEP_PX` a frame is taken, else the one that moves least.
     fn plan_hop(&self, dynamics: &Dynamics<'_>, rng: &mut RngStream) -> Hop {
         let params = dynamics.params;
         let g = params.gravity_px_per_frame2;
         let v = uniform(rng, params.launch_speed_px_per_frame);
         let nominal = (2.0 * v / g).round().max(1.0) as u64;
-        let mut frames = nominal
+        let longest = (3 * nominal)
             .min(self.flight.frames_left)
-            .min(u64::from(u32::MAX)) as u32;
-        loop {
+            .clamp(1, u64::from(u32::MAX)) as u32;
+        let mut best: Option<(bool, u64, f64, Hop)> = None;
+        for frames in 1..=longest {
             let hop = self.hop_of(frames, dynamics);
-            let top = (1..frames)
+            let apex = (1..frames)
                 .map(|k| hop.at(k).y)
                 .fold(f64::INFINITY, f64::min);
-            if frames <= 1 || top >= 0.0 {
-                return hop;
+            if frames > 1 && apex < 0.0 {
+                continue;
             }
-            frames -= 1;
+            let step = (1..=frames)
+                .map(|k| hop.at(k).distance(hop.at(k - 1)))
+                .fold(0.0, f64::max);
+            // Smooth enough first, then closest to the nominal length, then least steep.
+            let rank = (
+                step > MAX_STEP_PX,
+                u64::from(frames).abs_diff(nominal),
+                step,
+            );
+            let better = best.as_ref().is_none_or(|b| {
+                (rank.0, rank.1) < (b.0, b.1) || ((rank.0, rank.1) == (b.0, b.1) && rank.2 < b.2)
+            });
+            if better {
+                best = Some((rank.0, rank.1, rank.2, hop));
+            }
         }
+        best.map_or_else(|| self.hop_of(1, dynamics), |b| b.3)
     }
 
     /// The hop of `frames` frames from the current position, gravity at least `g`.
     fn hop_of(&self, frames: u32, dynamics: &Dynamics<'_>) -> Hop {
         let params = dynamics.params;
-        let start = self.pos;
+        let start = self.anchor;
         let end_x = start.x + self.flight.vel_x * f64::from(frames);
         let mut hop = Hop {
             start,
-            end: dynamics.on_surface(end_x, self.class),
+            end: Point2::new(end_x, dynamics.top.y(end_x, self.class)),
             frames,
             elapsed: 0,
             gravity: params.gravity_px_per_frame2,
@@ -276,7 +328,7 @@ impl Mover {
         for k in (1..frames).map(f64::from) {
             let chord = start.y + (hop.end.y - start.y) * k / m;
             let x = start.x + self.flight.vel_x * k;
-            let ceiling = dynamics.surface.y(x, self.class) - params.hop_clearance_px;
+            let ceiling = dynamics.top.y(x, self.class) - params.hop_clearance_px;
             hop.gravity = hop.gravity.max(2.0 * (chord - ceiling) / (k * (m - k)));
         }
         hop

@@ -47,8 +47,8 @@ pub struct BedloadSceneParams {
     /// Gravity of the hops, px/frame² (default 1.7: the buoyancy-reduced gravity of glass
     /// beads, 9.81·(1 − 1/2.5) m/s², at 130 frames/s and 2.056e-4 m/px).
     pub gravity_px_per_frame2: f64,
-    /// Least height above the bed surface of a saltating bead between two contacts, px
-    /// (default 0.5); a hop too short to clear the bed's bumps is steepened to keep it.
+    /// Least height above the pile (the bed and the beads on it) of a saltating bead between
+    /// two contacts, px (default 0.5); a hop too short to clear it is steepened to keep it.
     pub hop_clearance_px: f64,
     /// Largest displacement of a resting bead between two frames, px (default 0.05, at most
     /// 0.1): the position is its rest point plus a uniform offset in a disk of half that.
@@ -56,6 +56,23 @@ pub struct BedloadSceneParams {
     /// Radius of the static random offset of each bed bead from its lattice site, px
     /// (default 0.5, at most a tenth of the black radius): beads roughly in contact.
     pub bed_disorder_px: f64,
+    /// Closest centre distance of two beads, as a fraction of the sum of their radii, for
+    /// (black–black, black–transparent, transparent–transparent) pairs (default [0.93, 0.91,
+    /// 0.72]): beads touch at this distance and never come closer. The flume is 6.5 mm wide,
+    /// about one bead, so beads cannot pass through each other (§4.1); a 2-D projection
+    /// still shows them closer than the sum of their radii when they sit side by side in
+    /// depth, which the small beads can (6.5 − 2·4 = −1.5 mm: they overlap by up to 37 %).
+    /// The defaults are the median nearest-neighbour distances of each pair in the ten real
+    /// frames' ground truth (28.0, 22.8 and 14.3 px over sums of 30, 25 and 20 px), above
+    /// their minima (26.2, 20.6 and 12.5 px). The bed surface uses them too.
+    pub contact_factors: [f64; 3],
+    /// Least elevation of the contact through which a rolling bead climbs onto another
+    /// mobile bead, degrees (default 20): it rolls over a bead whose centre lies below its
+    /// own by at least the contact distance times sin 20° (a third of it), such as a small
+    /// bead sunk in a dip of the bed (28° for a black bead), and stops behind a bead about
+    /// as high as itself, which it would have to lift rather than roll over. The bed itself
+    /// never stops it.
+    pub min_climb_angle_deg: f64,
     /// Seed of every random draw (default 0).
     pub seed: u64,
 }
@@ -80,6 +97,8 @@ impl Default for BedloadSceneParams {
             hop_clearance_px: 0.5,
             resting_jitter_px: 0.05,
             bed_disorder_px: 0.5,
+            contact_factors: [0.93, 0.91, 0.72],
+            min_climb_angle_deg: 20.0,
             seed: 0,
         }
     }
@@ -154,6 +173,17 @@ impl BedloadSceneParams {
             0.0,
             self.black_radius_px / 10.0,
         )?;
+        for factor in self.contact_factors {
+            if !(factor.is_finite() && (0.5..=1.0).contains(&factor)) {
+                return Err(Error::parameter(
+                    "contact_factors",
+                    format!("{:?}", self.contact_factors),
+                    "each factor (black–black, black–transparent, transparent–transparent) \
+                     must be in [0.5, 1]",
+                ));
+            }
+        }
+        check("min_climb_angle_deg", self.min_climb_angle_deg, 0.0, 90.0)?;
         self.validate_bed()
     }
 
@@ -206,6 +236,13 @@ impl BedloadSceneParams {
         } else {
             self.transparent_radius_px
         }
+    }
+
+    /// The closest distance of the centres of two beads of classes `a` and `b`, px: the sum
+    /// of their radii times the pair's `contact_factors` entry.
+    pub fn contact_distance_px(&self, a: ObjectClass, b: ObjectClass) -> f64 {
+        let transparent = usize::from(a != BLACK_BEAD_CLASS) + usize::from(b != BLACK_BEAD_CLASS);
+        self.contact_factors[transparent] * (self.radius_px(a) + self.radius_px(b))
     }
 
     /// The stationary distribution of the transition table over (resting, rolling,
@@ -264,7 +301,7 @@ mod tests {
     #[test]
     fn bad_values_name_their_key() {
         type Case = (&'static str, fn(&mut BedloadSceneParams));
-        let cases: [Case; 14] = [
+        let cases: [Case; 16] = [
             ("width", |p| p.width = 0),
             ("n_transparent", |p| p.n_transparent = usize::MAX),
             ("n_black", |p| p.n_black = 100),
@@ -287,6 +324,8 @@ mod tests {
             ("gravity_px_per_frame2", |p| p.gravity_px_per_frame2 = 0.0),
             ("resting_jitter_px", |p| p.resting_jitter_px = 0.2),
             ("bed_disorder_px", |p| p.bed_disorder_px = 5.0),
+            ("contact_factors", |p| p.contact_factors[2] = 0.4),
+            ("min_climb_angle_deg", |p| p.min_climb_angle_deg = f64::NAN),
         ];
         for (key, spoil) in cases {
             let mut params = BedloadSceneParams::default();

@@ -8,8 +8,9 @@ use sillage_core::{
 };
 
 use super::BedloadSceneParams;
-use super::bed::{Bed, disk_offset};
+use super::bed::{Bed, BedSurface, disk_offset};
 use super::motion::{Dynamics, Mover, uniform};
+use super::pile::{Pile, Proposal};
 
 /// Stream of the bed's disorder.
 pub(crate) const STREAM_BED: u64 = 0xBED0_0001;
@@ -19,6 +20,10 @@ pub(crate) const STREAM_START: u64 = 0xBED0_0002;
 pub(crate) const STREAM_MOTION: u64 = 0xBED0_0003;
 /// Stream of the resting beads' jitter.
 pub(crate) const STREAM_JITTER: u64 = 0xBED0_0004;
+
+/// Width of the span at the upstream edge where new beads enter (at its lowest point), in
+/// black bead diameters: wide enough that arrivals spread rather than heap up at the edge.
+const ENTRY_SPAN_BLACK_DIAMETERS: f64 = 4.0;
 
 /// One true bead in one frame.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -76,30 +81,44 @@ impl BedloadFrame {
 }
 
 /// The synthetic bedload scene: a static bed of black beads in hexagonal layers in contact,
-/// and mobile beads (the black ones beyond the bed, all transparent ones) resting on its
-/// surface, rolling along it downstream, or saltating above it in hops, their states drawn
-/// per frame from the transition table.
+/// and mobile beads (the black ones beyond the bed, all transparent ones) resting on it or
+/// on each other, rolling downstream over the bed and over lower beads, or saltating above
+/// them in hops, their states drawn per frame from the transition table.
+///
+/// The flume is 6.5 mm wide, about one bead (MMPF+ §4.1), so beads do not pass through each
+/// other: no two beads come closer than their contact distance (`contact_factors` times the
+/// sum of their radii, the real frames' typical distance of touching beads), see
+/// [`BedloadSceneParams::contact_factors`]. Each frame, every mobile bead draws its state
+/// and its move, then takes its place among the others, bottom first: it lies on the upper
+/// envelope of the bed and of the beads below it, is held back where it would have to climb
+/// onto a bead not lower than itself (`min_climb_angle_deg`), drop off a ledge higher than
+/// its diameter or run into a bead above, and does not move while another bead lies on it.
 ///
 /// The motion agrees with the state: a resting bead moves by at most `resting_jitter_px`;
-/// a rolling one advances by its speed along x and stays on the surface; a saltation keeps
-/// its horizontal speed and flies in ballistic hops, at least `hop_clearance_px` above the
-/// surface between contacts, rebounding on it (Eq. (3)'s saltating-rebound). So that
-/// saltations can land, their length is drawn at take-off from the geometric law of the
-/// table's saltating row and the hops are fitted to land on the last frame: the transition
-/// frequencies are still the table's (the next state after a landing is drawn from the
-/// saltating row without its saltating entry).
+/// a rolling one advances downstream by at most its speed, on the bed or on beads (never
+/// upstream, but it may be held back to a standstill); a saltation keeps its horizontal
+/// speed and flies in ballistic hops, at least `hop_clearance_px` above the pile's top
+/// between contacts, rebounding on the bed or on a bead it meets (Eq. (3)'s
+/// saltating-rebound). So that saltations can land, their length is drawn at take-off from
+/// the geometric law of the table's saltating row and the hops are fitted to land on the
+/// last frame: the transition frequencies are still the table's (the next state after a
+/// landing is drawn from the saltating row without its saltating entry).
 ///
-/// A mobile bead whose centre passes the downstream edge is replaced by a new bead (a new
-/// identity) of the same class entering, rolling, at the upstream edge, so the counts stay
-/// constant; centres never leave the frame. Mobile beads pass in front of one another (the
-/// paper's flume is 6.5 mm wide: a 2-D projection) and rest on the bed only, not on each
-/// other. Streams frames `0..n_frames` in bounded memory.
+/// A mobile bead whose centre would pass the downstream edge is replaced by a new bead (a
+/// new identity) of the same class entering, rolling, from above at the lowest point of the
+/// 4 black diameters next to the upstream edge, so the counts stay constant; centres never
+/// leave the frame. Streams frames `0..n_frames` in bounded memory.
 #[derive(Debug, Clone)]
 pub struct BedloadScene {
     params: BedloadSceneParams,
     bed: Bed,
     bed_pos: Vec<Point2>,
     movers: Vec<Mover>,
+    positions: Vec<Point2>,
+    pile: Pile,
+    proposals: Vec<Proposal>,
+    next_states: Vec<MotionState>,
+    top: BedSurface,
     previous: Vec<(TrackId, Point2)>,
     motion: RngStream,
     jitter: RngStream,
@@ -109,8 +128,8 @@ pub struct BedloadScene {
 
 impl BedloadScene {
     /// Frame 0 of the scene `params` describe; fails on invalid parameters, naming the key.
-    /// Mobile beads start at uniform x on the surface, in states drawn from the table's
-    /// stationary distribution.
+    /// Mobile beads are dropped at uniform x, in slot order, on the bed and the beads
+    /// already there, in states drawn from the table's stationary distribution.
     pub fn new(params: BedloadSceneParams) -> Result<Self> {
         params.validate()?;
         let bed = Bed::new(&params, &mut rng_stream(params.seed, STREAM_BED));
@@ -123,9 +142,10 @@ impl BedloadScene {
         let dynamics = Dynamics {
             params: &params,
             surface: &bed.surface,
+            top: &bed.surface,
         };
         let last_x = params.width as f64 - 1.0;
-        let movers: Vec<Mover> = classes
+        let mut movers: Vec<Mover> = classes
             .enumerate()
             .map(|(i, class)| {
                 let x = last_x * start.random::<f64>();
@@ -147,11 +167,27 @@ impl BedloadScene {
                 )
             })
             .collect();
+        let proposals: Vec<Proposal> = movers
+            .iter()
+            .map(|m| Proposal::Drop { x: [m.anchor.x; 2] })
+            .collect();
+        let mut pile = Pile::new(&params, movers.len());
+        pile.settle(&mut movers, &proposals, &dynamics);
+        for mover in &mut movers {
+            if mover.state == MotionState::Saltating {
+                mover.launch(&dynamics, &mut start);
+            }
+        }
         Ok(Self {
             next_id: (n_bed + movers.len()) as TrackId,
             bed_pos: bed.anchors.clone(),
+            positions: movers.iter().map(|m| m.anchor).collect(),
+            top: bed.surface.clone(),
             bed,
             movers,
+            pile,
+            proposals,
+            next_states: Vec::new(),
             previous: Vec::new(),
             motion: rng_stream(params.seed, STREAM_MOTION),
             jitter: rng_stream(params.seed, STREAM_JITTER),
@@ -170,8 +206,8 @@ impl BedloadScene {
         self.bed_pos.len()
     }
 
-    /// The y of the centre of a bead of `class` resting on the bed at `x`: rolling beads
-    /// are on it, saltating ones on it or above (smaller y), px.
+    /// The y of the centre of a bead of `class` resting on the bed at `x`, px: mobile beads
+    /// are on it or above (smaller y), on the bed's beads or on other mobile beads.
     pub fn surface_y(&self, x: f64, class: ObjectClass) -> f64 {
         self.bed.surface.y(x, class)
     }
@@ -198,7 +234,8 @@ impl BedloadScene {
         let movers = self
             .movers
             .iter()
-            .map(|m| (m.track_id, m.class, m.pos, m.state, false));
+            .zip(&self.positions)
+            .map(|(m, &pos)| (m.track_id, m.class, pos, m.state, false));
         let beads: Vec<TrueBead> = bed
             .chain(movers)
             .enumerate()
@@ -223,7 +260,7 @@ impl BedloadScene {
         Some(BedloadFrame { index, beads })
     }
 
-    /// Moves every bead one frame, replacing those that left.
+    /// Moves every bead one frame, replacing those that leave, and settles the contacts.
     fn advance(&mut self) {
         let half = self.params.resting_jitter_px / 2.0;
         let last = Point2::new(
@@ -234,24 +271,51 @@ impl BedloadScene {
             let p = *anchor + disk_offset(&mut self.jitter, half);
             *pos = Point2::new(p.x.clamp(0.0, last.x), p.y.clamp(0.0, last.y));
         }
+        let loads = self.pile.loads();
+        self.next_states.clear();
+        for mover in &self.movers {
+            let next = mover.next_state(&self.params, &mut self.motion);
+            self.next_states.push(next);
+        }
+        // What saltating beads fly over: the bed and the beads staying on it.
+        self.top.clone_from(&self.bed.surface);
+        for (mover, &next) in self.movers.iter().zip(&self.next_states) {
+            if next != MotionState::Saltating {
+                self.top.lay(mover.anchor, mover.class, &self.params);
+            }
+        }
         let dynamics = Dynamics {
             params: &self.params,
             surface: &self.bed.surface,
+            top: &self.top,
         };
-        let direction = f64::from(self.params.flow_direction);
+        let direction = dynamics.direction();
         let (upstream, downstream) = if direction < 0.0 {
             (last.x, 0.0)
         } else {
             (0.0, last.x)
         };
-        for mover in &mut self.movers {
-            mover.step(&dynamics, &mut self.motion, &mut self.jitter);
-            if direction * (mover.pos.x - downstream) > 0.0 {
+        for (((mover, proposal), loaded), &next) in self
+            .movers
+            .iter_mut()
+            .zip(&mut self.proposals)
+            .zip(loads)
+            .zip(&self.next_states)
+        {
+            *proposal = mover.step(next, &dynamics, &mut self.motion, loaded);
+            let x = match *proposal {
+                Proposal::Ground { dx } => mover.anchor.x + dx,
+                Proposal::Drop { x } => x[0],
+                Proposal::Air { to, .. } => to.x,
+            };
+            if direction * (x - downstream) > 0.0 {
                 let reach = uniform(
                     &mut self.motion,
                     [0.0, self.params.rolling_speed_px_per_frame[1]],
                 );
                 let x = (upstream + direction * reach).clamp(0.0, last.x);
+                let entry =
+                    x + direction * ENTRY_SPAN_BLACK_DIAMETERS * 2.0 * self.params.black_radius_px;
                 *mover = Mover::new(
                     self.next_id,
                     mover.class,
@@ -260,7 +324,33 @@ impl BedloadScene {
                     &dynamics,
                     &mut self.motion,
                 );
+                *proposal = Proposal::Drop {
+                    x: [x, entry.clamp(0.0, last.x)],
+                };
                 self.next_id += 1;
+            }
+        }
+        self.pile
+            .settle(&mut self.movers, &self.proposals, &dynamics);
+        for (i, ((mover, proposal), pos)) in self
+            .movers
+            .iter_mut()
+            .zip(&self.proposals)
+            .zip(&mut self.positions)
+            .enumerate()
+        {
+            match *proposal {
+                Proposal::Air { .. } => mover.end_flight_frame(self.pile.stopped(i)),
+                // `pos` is still where it was seen in the last frame.
+                Proposal::Ground { .. } if mover.anchor.y > pos.y + half + 1e-9 => mover.fall(),
+                _ => {}
+            }
+            // A resting bead is seen off its place by the jitter, kept in the frame by a
+            // projection, which cannot lengthen a displacement.
+            *pos = mover.anchor;
+            if mover.state == MotionState::Resting {
+                let p = mover.anchor + disk_offset(&mut self.jitter, half);
+                *pos = Point2::new(p.x.clamp(0.0, last.x), p.y);
             }
         }
     }
