@@ -177,18 +177,22 @@ impl BeadDetector {
                 base.height()
             )));
         }
-        self.bright_base.clone_from(frame);
-        if let Some(base) = &self.base {
-            for (v, &b) in self
-                .bright_base
-                .as_mut_slice()
-                .iter_mut()
-                .zip(base.as_slice())
-            {
-                if b {
-                    *v = 1.0;
+        match &self.base {
+            Some(base) => {
+                self.bright_base.reshape(frame.width(), frame.height());
+                for ((v, &f), &b) in self
+                    .bright_base
+                    .as_mut_slice()
+                    .iter_mut()
+                    .zip(frame.as_slice())
+                    .zip(base.as_slice())
+                {
+                    // Branch-free (a bit select), so that it vectorises.
+                    let keep = u32::from(b).wrapping_sub(1);
+                    *v = f32::from_bits((f.to_bits() & keep) | (1.0f32.to_bits() & !keep));
                 }
             }
+            None => self.bright_base.clone_from(frame),
         }
         self.black.detect(&self.bright_base, &mut out.black);
         self.transparent.detect(

@@ -130,21 +130,22 @@ impl TransparentStage {
     ) {
         let (width, height) = frame.dimensions();
         self.top_hat.reshape(width, height);
-        for ((t, &c), &f) in self
+        let pixels = self
             .top_hat
             .as_mut_slice()
             .iter_mut()
             .zip(self.closed.as_slice())
-            .zip(frame.as_slice())
-        {
-            *t = c - f;
-        }
-        if let Some(base) = base {
-            for (t, &b) in self.top_hat.as_mut_slice().iter_mut().zip(base.as_slice()) {
-                if b {
-                    *t = 0.0;
+            .zip(frame.as_slice());
+        match base {
+            Some(base) => {
+                // Branch-free (`c − f` with its bits cleared on the base), so that it
+                // vectorises.
+                for (((t, &c), &f), &b) in pixels.zip(base.as_slice()) {
+                    let keep = u32::from(b).wrapping_sub(1);
+                    *t = f32::from_bits((c - f).to_bits() & keep);
                 }
             }
+            None => pixels.for_each(|((t, &c), &f)| *t = c - f),
         }
         for bead in black {
             let (cx, cy) = (
