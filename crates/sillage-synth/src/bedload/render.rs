@@ -618,19 +618,10 @@ impl BedloadRenderer {
     /// disk, blended with what lies beneath on its edge.
     fn draw_black(&self, centre: Point2, band: &Band<'_>, pixels: &mut [f32]) {
         let black_level = self.params.black_level as f32;
-        let (reach2, reach) = self.black_reach;
+        let reach2 = self.black_reach.0;
         let full_px2 = self.black_cover.full_px2;
         let rows = pixels.len() / band.width;
-        let Some((r0, r1)) = clipped(centre.y - reach, centre.y + reach, band.y0, band.y0 + rows)
-        else {
-            return;
-        };
-        for y in r0..=r1 {
-            let dy2 = (y as f64 - centre.y).powi(2);
-            let half = (reach2 - dy2).max(0.0).sqrt();
-            let Some((c0, c1)) = clipped(centre.x - half, centre.x + half, 0, band.width) else {
-                continue;
-            };
+        for (y, dy2, c0, c1) in disk_spans(centre, self.black_reach, band, rows) {
             let row = &mut pixels[(y - band.y0) * band.width..(y - band.y0 + 1) * band.width];
             // The fully covered span, [c1 + 1, c1] (empty) when there is none.
             let inner = (full_px2 - dy2).max(0.0).sqrt();
@@ -659,6 +650,28 @@ struct Band<'a> {
     light: &'a [f32],
 }
 
+/// The rows of the disk of squared radius `reach.0` (`reach.1` its root) around `centre` that
+/// fall in the `rows` rows of `band`: `(y, dy², first column, last column)`, columns clipped to
+/// the frame.
+fn disk_spans(
+    centre: Point2,
+    (reach2, reach): (f64, f64),
+    band: &Band<'_>,
+    rows: usize,
+) -> impl Iterator<Item = (usize, f64, usize, usize)> {
+    let width = band.width;
+    let row_span = clipped(centre.y - reach, centre.y + reach, band.y0, band.y0 + rows);
+    row_span
+        .into_iter()
+        .flat_map(|(r0, r1)| r0..=r1)
+        .filter_map(move |y| {
+            let dy2 = (y as f64 - centre.y).powi(2);
+            let half = (reach2 - dy2).max(0.0).sqrt();
+            let (c0, c1) = clipped(centre.x - half, centre.x + half, 0, width)?;
+            Some((y, dy2, c0, c1))
+        })
+}
+
 /// Calls `f(x, y, d², pixel, backlight)` on the pixels of `band` (`pixels`) whose squared
 /// distance to `centre` is below `reach.0` (`reach.1` its square root), row span by row span.
 fn each_pixel(
@@ -669,16 +682,7 @@ fn each_pixel(
     mut f: impl FnMut(usize, usize, f64, &mut f32, f32),
 ) {
     let rows = pixels.len() / band.width;
-    let Some((r0, r1)) = clipped(centre.y - reach, centre.y + reach, band.y0, band.y0 + rows)
-    else {
-        return;
-    };
-    for y in r0..=r1 {
-        let dy2 = (y as f64 - centre.y).powi(2);
-        let half = (reach2 - dy2).max(0.0).sqrt();
-        let Some((c0, c1)) = clipped(centre.x - half, centre.x + half, 0, band.width) else {
-            continue;
-        };
+    for (y, dy2, c0, c1) in disk_spans(centre, (reach2, reach), band, rows) {
         let start = (y - band.y0) * band.width;
         let span = start + c0..=start + c1;
         for ((x, v), &light) in (c0..).zip(&mut pixels[span.clone()]).zip(&band.light[span]) {
