@@ -561,6 +561,22 @@ impl From<BedloadTrackerArg> for sillage::track::bedload::BedloadTrackerKind {
     }
 }
 
+/// Output formats of bead trajectories.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BeadFormatArg {
+    /// CSV in the layout of BeadTracking's ground truth,
+    /// `frame,id,x,y,category,vx,vy,motion_state,spread_px` (1-based frames and pixels,
+    /// motion-state codes 0-3): what `sillage eval mot` compares with bead truth.
+    Beads,
+    /// CSV with trackpy column names then `class,motion_state,spread_px` (0-based, state
+    /// names).
+    Csv,
+    /// Apache Parquet with the CSV's columns.
+    Parquet,
+    /// HDF5, one dataset per column (needs the `hdf5` cargo feature).
+    Hdf5,
+}
+
 /// `sillage track bedload`.
 #[derive(Debug, Args)]
 pub struct TrackBedloadArgs {
@@ -576,10 +592,13 @@ pub struct TrackBedloadArgs {
     /// unclaimed detections of its class.
     #[arg(long, value_name = "FILE")]
     pub candidates: Option<PathBuf>,
-    /// Trajectories to write (CSV `frame,id,x,y,category,vx,vy,motion_state,spread_px`,
-    /// 1-based frames and pixels as BeadTracking's ground truth).
+    /// Trajectories to write; the format from `--format`, else from the extension: `.csv`
+    /// in BeadTracking's layout, `.parquet`, `.h5`.
     #[arg(long, short, value_name = "FILE")]
     pub out: PathBuf,
+    /// Output format (default: `beads` for `.csv`, else from the extension of --out).
+    #[arg(long, value_enum)]
+    pub format: Option<BeadFormatArg>,
     /// TOML parameters (sections `association`, `likelihood`, `states`, `survival`,
     /// `filter`, `motion`, ...; `sillage fit bedload` writes `motion`).
     #[arg(long, value_name = "FILE")]

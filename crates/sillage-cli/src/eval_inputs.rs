@@ -13,8 +13,8 @@ use sillage::eval::mot::{
 use sillage::eval::papers::StateLabel;
 use sillage::io::{
     BEAD_HEADER, BeadPoint, BeadSequenceParams, MotFileRole, MotRow, TRACK_COLUMNS, TRUTH_HEADER,
-    TrackFormat, read_bead_csv, read_bead_sequence_params, read_mot_rows, read_mot_sequence,
-    read_tracks, read_truth_csv,
+    TrackFormat, TrackLayout, read_bead_csv, read_bead_sequence_params, read_mot_rows,
+    read_mot_sequence, read_track_table, read_truth_csv,
 };
 
 use crate::cli::MatchRule;
@@ -232,10 +232,31 @@ fn read_objects(path: &Path, with_seqinfo: bool) -> Result<(Objects, Option<u64>
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     let points = |points: Vec<(FrameIndex, u64, Point2)>| Ok((Objects::Points(points), None));
+    // Tables with motion states (bedload trackers) are beads; the others points.
     let tracks = |format: TrackFormat| {
-        let tracks = read_tracks(path, format)?;
+        let table = read_track_table(path, format)?;
+        if table.layout == TrackLayout::WithStates {
+            let beads = table
+                .points
+                .iter()
+                .map(|p| {
+                    BeadPoint::from_track_point(p).ok_or_else(|| {
+                        anyhow!(
+                            "{}: track {} at frame {} has class {}; bead tracks have class 0 \
+                             (black) or 1 (transparent)",
+                            path.display(),
+                            p.track_id,
+                            p.frame,
+                            p.class
+                        )
+                    })
+                })
+                .collect::<Result<_>>()?;
+            return Ok((Objects::Beads(beads), None));
+        }
         points(
-            tracks
+            table
+                .points
                 .iter()
                 .map(|p| (p.frame, p.track_id, p.pos_px))
                 .collect(),

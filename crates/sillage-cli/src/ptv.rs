@@ -54,6 +54,7 @@ pub fn track_header(config: &PipelineConfig) -> Result<TrackFileHeader> {
     Ok(TrackFileHeader {
         program_version: format!("sillage {}", env!("CARGO_PKG_VERSION")),
         parameters,
+        ..TrackFileHeader::default()
     })
 }
 

@@ -1,6 +1,6 @@
 //! `sillage track bedload`: the bedload trackers (MMPF+ and the baselines of its Table 1) on
 //! detections read from CSV, or on frames through the bead detector; trajectories written in
-//! BeadTracking's layout.
+//! BeadTracking's layout or as a track table with motion states.
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -9,11 +9,12 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use sillage::core::{Detection, FrameIndex, FrameObservations, Tracker};
 use sillage::detect::BeadDetections;
-use sillage::io::{BeadCsvWriter, FrameOptions, open_frames, read_bead_csv, read_detections_csv};
+use sillage::io::{FrameOptions, open_frames, read_detections_csv};
 use sillage::toml_config::{read_toml_file, set_key};
 use sillage::track::bedload::{BedloadTracker, BedloadTrackerParams};
 use sillage::viz::OverlayStyle;
 
+use crate::bead_output::BeadTrackOutput;
 use crate::cli::TrackBedloadArgs;
 use crate::detect::{build_detector, detect_frame};
 use crate::overlay::{DetectionsByFrame, write_overlays};
@@ -123,7 +124,8 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
         (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
     };
     let mut tracker = BedloadTracker::new(&params)?;
-    let mut writer = BeadCsvWriter::create(&args.out)?;
+    let mut writer = BeadTrackOutput::create(&args.out, args.format, &params)?;
+    let kind = writer.kind();
     let mut progress = FrameProgress::new(total, "tracking");
     let start = Instant::now();
     let mut outcome = Ok(());
@@ -162,10 +164,7 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     };
     outcome.with_context(|| format!("while tracking {source}"))?;
     if let (Some(dir), Some(input)) = (&args.overlay, &args.input) {
-        let tracks = read_bead_csv(&written.path)?
-            .iter()
-            .map(|b| b.track_point())
-            .collect();
+        let tracks = kind.read(&written.path)?;
         let style = OverlayStyle {
             tail_frames: args.overlay_tail,
             detection_radius_px: params.radius_px.clone(),

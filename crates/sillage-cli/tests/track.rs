@@ -142,6 +142,81 @@ fn every_tracker_runs_and_the_output_is_reproducible() {
     }
 }
 
+/// `eval mot --papers` of `pred` against the scene's truth, without the file names.
+fn paper_scores(dir: &Path, pred: &Path) -> serde_json::Value {
+    let output = sillage(&[
+        "eval",
+        "mot",
+        "--gt",
+        path_str(&dir.join("truth.csv")),
+        "--pred",
+        path_str(pred),
+        "--match",
+        "disc:0.43",
+        "--papers",
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let scores: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    scores["sequences"][0]["papers"].clone()
+}
+
+#[test]
+fn every_output_format_carries_the_motion_states() {
+    let dir = tempfile::tempdir().unwrap();
+    write_scene(dir.path());
+    track(dir.path(), "mmpf-plus");
+    let beads = paper_scores(dir.path(), &dir.path().join("tracks_mmpf-plus.csv"));
+    assert!(
+        find(&beads["motion_states"], "f_score").is_some(),
+        "{beads}"
+    );
+    let mut outputs = vec![("csv", "tracks.csv"), ("parquet", "tracks.parquet")];
+    if cfg!(feature = "hdf5") {
+        outputs.push(("hdf5", "tracks.h5"));
+    }
+    for (format, name) in outputs {
+        let out = dir.path().join(name);
+        let output = sillage(&[
+            "track",
+            "bedload",
+            "--detections",
+            path_str(&dir.path().join("det.csv")),
+            "--candidates",
+            path_str(&dir.path().join("cand.csv")),
+            "--out",
+            path_str(&out),
+            "--format",
+            format,
+        ]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        // The same tracks, categories and states as BeadTracking's layout.
+        assert_eq!(paper_scores(dir.path(), &out), beads, "{format}");
+    }
+    let text = std::fs::read_to_string(dir.path().join("tracks.csv")).unwrap();
+    assert!(text.starts_with(
+        "frame,particle,x,y,vx,vy,ax,ay,vx_pred,vy_pred,log_err,class,motion_state,spread_px\n"
+    ));
+    assert!(text.contains(",1,rolling,"), "transparent beads rolling");
+    // TracTrac's layout has no state columns: refused, nothing written.
+    let txt = dir.path().join("tracks_track.txt");
+    let output = sillage(&[
+        "track",
+        "bedload",
+        "--detections",
+        path_str(&dir.path().join("det.csv")),
+        "--out",
+        path_str(&txt),
+    ]);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(
+        stderr(&output).contains("motion states"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(!txt.exists());
+}
+
 #[test]
 fn bad_inputs_and_parameters_fail_with_clear_messages() {
     let dir = tempfile::tempdir().unwrap();

@@ -65,6 +65,49 @@ pub enum MotionState {
     Saltating,
 }
 
+impl MotionState {
+    /// Every state, in the order of BeadTracking's codes (resting 0 … unknown 3).
+    pub const ALL: [MotionState; 4] =
+        [Self::Resting, Self::Rolling, Self::Saltating, Self::Unknown];
+
+    /// The lowercase name written in CSV and Parquet track tables (`resting`, `rolling`,
+    /// `saltating`, `unknown`), the same as the serde name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Unknown => "unknown",
+            Self::Resting => "resting",
+            Self::Rolling => "rolling",
+            Self::Saltating => "saltating",
+        }
+    }
+
+    /// The state named `name` (any case), `None` for another name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|s| s.name().eq_ignore_ascii_case(name.trim()))
+    }
+
+    /// BeadTracking's code of the state, as in its ground truth (`trackData` row 9): 0
+    /// resting, 1 rolling, 2 saltating, 3 unknown.
+    pub const fn bead_tracking_code(self) -> u8 {
+        match self {
+            Self::Resting => 0,
+            Self::Rolling => 1,
+            Self::Saltating => 2,
+            Self::Unknown => 3,
+        }
+    }
+
+    /// The state of BeadTracking's code `code` (see [`MotionState::bead_tracking_code`]);
+    /// `None` for any other value, fractional ones included.
+    pub fn from_bead_tracking_code(code: f64) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|s| f64::from(s.bead_tracking_code()) == code)
+    }
+}
+
 /// One final point of one trajectory, as a tracker emits it.
 ///
 /// Kinematic fields are `None` where the tracker does not estimate them.

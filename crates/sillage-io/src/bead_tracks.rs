@@ -9,7 +9,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use sillage_core::{Error, MotionState, Result, TrackPoint, TrackSink};
+use sillage_core::{Error, Result, TrackPoint, TrackSink};
 
 use crate::WrittenSummary;
 use crate::text_table::{RowWriter, push_opt};
@@ -50,12 +50,7 @@ impl TrackSink for BeadCsvWriter {
                     p.track_id, p.frame, p.class, p.pos_px.x, p.pos_px.y
                 )));
             }
-            let state = match p.motion_state {
-                MotionState::Resting => 0,
-                MotionState::Rolling => 1,
-                MotionState::Saltating => 2,
-                MotionState::Unknown => 3,
-            };
+            let state = p.motion_state.bead_tracking_code();
             // Writing to a String cannot fail.
             let _ = write!(
                 out,
@@ -78,7 +73,7 @@ impl TrackSink for BeadCsvWriter {
 
 #[cfg(test)]
 mod tests {
-    use sillage_core::{Point2, Vec2};
+    use sillage_core::{MotionState, Point2, Vec2};
 
     use super::*;
     use crate::{BeadCategory, read_bead_csv};

@@ -46,6 +46,24 @@ pub struct BeadPoint {
 }
 
 impl BeadPoint {
+    /// The bead a tracker's point stands for (class 0 black, 1 transparent); `None` for
+    /// another class — the inverse of [`BeadPoint::track_point`].
+    pub fn from_track_point(point: &TrackPoint) -> Option<Self> {
+        let category = match point.class {
+            BLACK_BEAD_CLASS => BeadCategory::Black,
+            TRANSPARENT_BEAD_CLASS => BeadCategory::Transparent,
+            _ => return None,
+        };
+        Some(Self {
+            frame: point.frame,
+            id: point.track_id,
+            pos_px: point.pos_px,
+            category,
+            vel_px_per_frame: point.vel_px_per_frame,
+            motion_state: point.motion_state,
+        })
+    }
+
     /// The point as a track point: `id` as the track id, the category as the class
     /// (`BLACK_BEAD_CLASS`, `TRANSPARENT_BEAD_CLASS`), velocity and motion state kept — the
     /// form trackers emit and `score_bead_tracks` compares.
@@ -93,16 +111,12 @@ pub fn read_bead_csv(path: impl AsRef<Path>) -> Result<Vec<BeadPoint>> {
         let motion_state = match row.optional(7)? {
             None => MotionState::Unknown,
             Some(s) if s.is_nan() => MotionState::Unknown,
-            Some(0.0) => MotionState::Resting,
-            Some(1.0) => MotionState::Rolling,
-            Some(2.0) => MotionState::Saltating,
-            Some(3.0) => MotionState::Unknown,
-            Some(s) => {
-                return Err(row.error(format!(
+            Some(s) => MotionState::from_bead_tracking_code(s).ok_or_else(|| {
+                row.error(format!(
                     "`motion_state` = {s}; it is 0 (resting), 1 (rolling), 2 (saltating) or 3 \
                      (unknown)"
-                )));
-            }
+                ))
+            })?,
         };
         points.push(BeadPoint {
             frame,

@@ -7,7 +7,9 @@
 //! - [`open_frames`] turns an INPUT string into a [`FrameSource`], an iterator of
 //!   [`Frame`]s decoded ahead on a background thread (bounded memory);
 //! - [`create_track_writer`] gives a [`TrackWriter`], a [`sillage_core::TrackSink`] that
-//!   streams points into a file; [`read_tracks`] reads one back;
+//!   streams points into a file (with classes and motion states in the
+//!   [`TrackLayout::WithStates`] columns); [`read_tracks`] / [`read_track_table`] read one
+//!   back;
 //! - [`TruthCsvWriter`] / [`read_truth_csv`], [`DetectionsCsvWriter`] /
 //!   [`read_detections_csv`] for ground truth and saved detections;
 //! - [`read_tractrac_par`] / [`write_tractrac_par`] for TracTrac's `*_par.txt`;
@@ -86,8 +88,8 @@ pub use mot::{
 };
 pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
 pub use tracks::{
-    TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackWriter,
-    WrittenSummary, create_track_writer, read_tracks,
+    STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackLayout,
+    TrackTable, TrackWriter, WrittenSummary, create_track_writer, read_track_table, read_tracks,
 };
 pub use tractrac_par::{
     TRACTRAC_KEYS, TractracPar, parse_tractrac_par, read_tractrac_par, write_tractrac_par,

@@ -127,6 +127,11 @@ impl CsvTable {
         Ok(table)
     }
 
+    /// Whether wanted column `column` is in the file (always, for a required one).
+    pub(crate) fn has(&self, column: usize) -> bool {
+        self.indices[column].is_some()
+    }
+
     /// Calls `each` on every data row, in order.
     pub(crate) fn for_each_row(
         &self,
@@ -189,7 +194,8 @@ impl CsvRow<'_> {
         Error::format(&self.table.path, line, message)
     }
 
-    fn text(&self, column: usize) -> Option<&str> {
+    /// Wanted column `column` as text; `None` when empty or absent.
+    pub(crate) fn text(&self, column: usize) -> Option<&str> {
         self.table.indices[column]
             .and_then(|i| self.record.get(i))
             .filter(|t| !t.is_empty())

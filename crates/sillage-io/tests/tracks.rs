@@ -3,9 +3,10 @@
 
 use std::path::Path;
 
-use sillage_core::{Point2, TrackPoint, Vec2};
+use sillage_core::{MotionState, Point2, TrackPoint, Vec2};
 use sillage_io::{
-    TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, create_track_writer, read_tracks,
+    TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackLayout, create_track_writer,
+    read_track_table, read_tracks,
 };
 
 fn sample_points(n: u64) -> Vec<TrackPoint> {
@@ -34,6 +35,7 @@ fn header() -> TrackFileHeader {
             ("peak_th".into(), "0.02".into()),
             ("tracker".into(), "ptv".into()),
         ],
+        ..TrackFileHeader::default()
     }
 }
 
@@ -288,4 +290,135 @@ fn non_finite_positions_are_refused_by_writers() {
     let mut writer = create_track_writer(&path, TrackFormat::Csv, &header()).unwrap();
     let bad = TrackPoint::at(0, 1, Point2::new(f64::NAN, 0.0));
     assert!(writer.accept(&[bad]).is_err());
+}
+
+/// Points with classes, motion states and spreads, as the bedload trackers emit them.
+fn bead_points(n: u64) -> Vec<TrackPoint> {
+    sample_points(n)
+        .into_iter()
+        .enumerate()
+        .map(|(i, p)| TrackPoint {
+            class: (i % 2) as u32,
+            motion_state: MotionState::ALL[i % 4],
+            spread_px: (i % 3 != 0).then_some(0.25 * i as f64),
+            ..p
+        })
+        .collect()
+}
+
+fn state_header() -> TrackFileHeader {
+    TrackFileHeader {
+        layout: TrackLayout::WithStates,
+        ..header()
+    }
+}
+
+fn write_states(path: &Path, format: TrackFormat, points: &[TrackPoint]) {
+    let mut writer = create_track_writer(path, format, &state_header()).unwrap();
+    for chunk in points.chunks(7) {
+        writer.accept(chunk).unwrap();
+    }
+    assert_eq!(writer.finish().unwrap().rows, points.len() as u64);
+}
+
+#[test]
+fn csv_with_states_round_trips_exactly_and_names_the_states() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("beads.csv");
+    let points = bead_points(40);
+    write_states(&path, TrackFormat::Csv, &points);
+    let table = read_track_table(&path, TrackFormat::Csv).unwrap();
+    assert_eq!(table.layout, TrackLayout::WithStates);
+    assert_eq!(table.points, points);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "frame,particle,x,y,vx,vy,ax,ay,vx_pred,vy_pred,log_err,class,motion_state,spread_px"
+    );
+    // Row 1 (i = 1): transparent, rolling, spread 0.25.
+    assert!(lines.nth(1).unwrap().ends_with(",1,rolling,0.25"), "{text}");
+    // A table without the state columns reads as the kinematic layout, states unknown.
+    let plain = dir.path().join("plain.csv");
+    write(&plain, TrackFormat::Csv, &points);
+    let table = read_track_table(&plain, TrackFormat::Csv).unwrap();
+    assert_eq!(table.layout, TrackLayout::Kinematics);
+    assert!(
+        table.points.iter().all(|p| p.class == 0
+            && p.motion_state == MotionState::Unknown
+            && p.spread_px.is_none())
+    );
+}
+
+#[cfg(feature = "parquet")]
+#[test]
+fn parquet_with_states_round_trips_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("beads.parquet");
+    let points = bead_points(70_000);
+    write_states(&path, TrackFormat::Parquet, &points);
+    let table = read_track_table(&path, TrackFormat::Parquet).unwrap();
+    assert_eq!(table.layout, TrackLayout::WithStates);
+    assert_eq!(table.points, points);
+}
+
+#[cfg(feature = "hdf5")]
+#[test]
+fn hdf5_with_states_round_trips_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("beads.h5");
+    let points = bead_points(70_000);
+    write_states(&path, TrackFormat::Hdf5, &points);
+    let table = read_track_table(&path, TrackFormat::Hdf5).unwrap();
+    assert_eq!(table.layout, TrackLayout::WithStates);
+    assert_eq!(table.points, points);
+}
+
+#[test]
+fn tractrac_refuses_the_state_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("beads_track.txt");
+    let Err(error) = create_track_writer(&path, TrackFormat::Tractrac, &state_header()) else {
+        panic!("TracTrac's layout took classes and motion states");
+    };
+    let error = error.to_string();
+    assert!(
+        error.contains("motion states") && error.contains("csv, parquet or hdf5"),
+        "{error}"
+    );
+    assert!(!path.exists());
+}
+
+#[test]
+fn csv_state_errors_name_the_line_and_the_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.csv");
+    std::fs::write(
+        &path,
+        "frame,particle,x,y,class,motion_state\n0,1,2.5,3.5,1,resting\n1,1,2.5,3.5,0,hopping\n",
+    )
+    .unwrap();
+    let error = read_tracks(&path, TrackFormat::Csv)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("bad.csv:3:") && error.contains("hopping"),
+        "{error}"
+    );
+    assert!(
+        error.contains("resting, rolling, saltating or unknown"),
+        "{error}"
+    );
+    std::fs::write(
+        &path,
+        "frame,particle,x,y,class,motion_state\n0,1,2.5,3.5,4294967296,resting\n",
+    )
+    .unwrap();
+    let error = read_tracks(&path, TrackFormat::Csv)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("bad.csv:2:") && error.contains("class 4294967296"),
+        "{error}"
+    );
 }

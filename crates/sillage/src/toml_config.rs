@@ -73,6 +73,33 @@ pub fn set_key<T: Serialize + DeserializeOwned>(config: &mut T, assignment: &str
     ))
 }
 
+/// Every leaf of `config` as `(dotted.key, TOML value text)`, sorted by key within a table:
+/// the parameters a track file records (`likelihood.gamma = 0.7`), the same keys as `--set`.
+pub fn dotted_keys<T: Serialize>(config: &T) -> Result<Vec<(String, String)>> {
+    let tree = toml::Value::try_from(config)
+        .map_err(|e| Error::input(format!("cannot serialise the configuration: {e}")))?;
+    let mut keys = Vec::new();
+    flatten_into(&tree, "", &mut keys);
+    Ok(keys)
+}
+
+fn flatten_into(node: &toml::Value, prefix: &str, keys: &mut Vec<(String, String)>) {
+    match node {
+        toml::Value::Table(table) => {
+            for (key, value) in table {
+                let dotted = if prefix.is_empty() {
+                    key.clone()
+                } else {
+                    format!("{prefix}.{key}")
+                };
+                flatten_into(value, &dotted, keys);
+            }
+        }
+        toml::Value::String(text) => keys.push((prefix.to_string(), text.clone())),
+        leaf => keys.push((prefix.to_string(), leaf.to_string())),
+    }
+}
+
 /// Reads `raw` as a TOML value; bare words that are not TOML become strings.
 fn parse_toml_value(raw: &str) -> toml::Value {
     toml::from_str::<toml::Table>(&format!("v = {raw}"))
@@ -110,4 +137,40 @@ fn insert_dotted(
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Serialize, serde::Deserialize)]
+    struct Inner {
+        gamma: f64,
+        name: String,
+    }
+
+    #[derive(Serialize, serde::Deserialize)]
+    struct Outer {
+        seed: u64,
+        likelihood: Inner,
+    }
+
+    #[test]
+    fn dotted_keys_name_every_leaf_as_set_does() {
+        let mut config = Outer {
+            seed: 3,
+            likelihood: Inner {
+                gamma: 0.5,
+                name: "mmpf".into(),
+            },
+        };
+        set_key(&mut config, "likelihood.gamma=0.7").unwrap();
+        let keys = dotted_keys(&config).unwrap();
+        let expected = [
+            ("likelihood.gamma", "0.7"),
+            ("likelihood.name", "mmpf"),
+            ("seed", "3"),
+        ];
+        assert_eq!(keys, expected.map(|(k, v)| (k.to_string(), v.to_string())));
+    }
 }

@@ -3,12 +3,13 @@
 
 use std::path::Path;
 
-use sillage_core::{Error, Point2, Result, TrackPoint};
+use sillage_core::{Error, MotionState, ObjectClass, Point2, Result, TrackPoint};
 
 use super::columns::{check_position, kinematics, point_from_values};
 
 /// Track points held column by column (the layout of Parquet row groups and HDF5 datasets).
-/// Missing values are `None`.
+/// Missing values are `None`; the state columns are always held, and written only by the
+/// state layout (a reader of a table without them fills them with class 0, unknown, `None`).
 #[derive(Debug, Default, Clone, PartialEq)]
 pub(crate) struct TrackColumns {
     pub(crate) frame: Vec<i64>,
@@ -16,6 +17,9 @@ pub(crate) struct TrackColumns {
     pub(crate) x: Vec<f64>,
     pub(crate) y: Vec<f64>,
     pub(crate) kinematics: [Vec<Option<f64>>; 7],
+    pub(crate) class: Vec<ObjectClass>,
+    pub(crate) motion_state: Vec<MotionState>,
+    pub(crate) spread_px: Vec<Option<f64>>,
 }
 
 impl TrackColumns {
@@ -31,6 +35,17 @@ impl TrackColumns {
         self.x.clear();
         self.y.clear();
         self.kinematics.iter_mut().for_each(Vec::clear);
+        self.class.clear();
+        self.motion_state.clear();
+        self.spread_px.clear();
+    }
+
+    /// Fills the state columns with "class 0, unknown, no spread" for a table without them.
+    pub(crate) fn default_states(&mut self) {
+        let n = self.len();
+        self.class = vec![0; n];
+        self.motion_state = vec![MotionState::Unknown; n];
+        self.spread_px = vec![None; n];
     }
 
     /// Appends one point (frame and track id are stored as i64, losslessly).
@@ -48,6 +63,10 @@ impl TrackColumns {
         for (column, value) in self.kinematics.iter_mut().zip(kinematics(point)) {
             column.push(value);
         }
+        self.class.push(point.class);
+        self.motion_state.push(point.motion_state);
+        self.spread_px
+            .push(point.spread_px.filter(|s| s.is_finite()));
         Ok(())
     }
 
@@ -69,12 +88,12 @@ impl TrackColumns {
                         pos.x, pos.y
                     )));
                 }
-                Ok(point_from_values(
-                    frame,
-                    id,
-                    pos,
-                    self.kinematics.each_ref().map(|c| c[i]),
-                ))
+                Ok(TrackPoint {
+                    class: self.class[i],
+                    motion_state: self.motion_state[i],
+                    spread_px: self.spread_px[i].filter(|s| s.is_finite()),
+                    ..point_from_values(frame, id, pos, self.kinematics.each_ref().map(|c| c[i]))
+                })
             })
             .collect()
     }

@@ -16,7 +16,7 @@ use std::str::FromStr;
 
 use sillage_core::{Error, Result, TrackPoint, TrackSink};
 
-pub use columns::TRACK_COLUMNS;
+pub use columns::{STATE_COLUMNS, TRACK_COLUMNS, TrackLayout};
 pub use text::TRACTRAC_COLUMNS_LINE;
 
 /// The file formats of a track table.
@@ -24,7 +24,8 @@ pub use text::TRACTRAC_COLUMNS_LINE;
 pub enum TrackFormat {
     /// TracTrac's ASCII `_track.txt` (3 `#` header lines, 11 space-separated columns).
     Tractrac,
-    /// CSV with the header `frame,particle,x,y,vx,vy,ax,ay,vx_pred,vy_pred,log_err`.
+    /// CSV with the header `frame,particle,x,y,vx,vy,ax,ay,vx_pred,vy_pred,log_err`
+    /// (then `class,motion_state,spread_px` with [`TrackLayout::WithStates`]).
     Csv,
     /// Apache Parquet with the CSV's column names (feature `parquet`).
     Parquet,
@@ -101,6 +102,17 @@ pub struct TrackFileHeader {
     /// The run's parameters as `(key, value)` text (TracTrac's header line 2, Parquet
     /// key-value metadata `param:KEY`, HDF5 attributes `param:KEY`).
     pub parameters: Vec<(String, String)>,
+    /// The columns to write (CSV, Parquet, HDF5; TracTrac's layout is fixed).
+    pub layout: TrackLayout,
+}
+
+/// A whole track table read back: its points and the layout of its columns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackTable {
+    /// The rows, in file order.
+    pub points: Vec<TrackPoint>,
+    /// [`TrackLayout::WithStates`] when the table has a motion-state column.
+    pub layout: TrackLayout,
 }
 
 /// What a finished writer wrote.
@@ -120,12 +132,20 @@ pub trait TrackWriter: TrackSink {
 }
 
 /// Creates a writer of `format` at `path` (written as `.NAME.partial` until finished).
+/// TracTrac's format refuses [`TrackLayout::WithStates`]: its 11 columns are fixed.
 pub fn create_track_writer(
     path: &Path,
     format: TrackFormat,
     header: &TrackFileHeader,
 ) -> Result<Box<dyn TrackWriter>> {
     match format {
+        TrackFormat::Tractrac if header.layout == TrackLayout::WithStates => {
+            Err(Error::input(format!(
+                "{}: TracTrac's _track.txt has no columns for classes and motion states; \
+                 write csv, parquet or hdf5 instead",
+                path.display()
+            )))
+        }
         TrackFormat::Tractrac => Ok(Box::new(text::TextTrackWriter::create(
             path,
             text::TextStyle::Tractrac,
@@ -133,7 +153,7 @@ pub fn create_track_writer(
         )?)),
         TrackFormat::Csv => Ok(Box::new(text::TextTrackWriter::create(
             path,
-            text::TextStyle::Csv,
+            text::TextStyle::Csv(header.layout),
             header,
         )?)),
         #[cfg(feature = "parquet")]
@@ -147,8 +167,14 @@ pub fn create_track_writer(
     }
 }
 
-/// Reads a whole track table of `format` at `path`.
+/// Reads the points of a whole track table of `format` at `path` (class, motion state and
+/// spread included when the table has them).
 pub fn read_tracks(path: &Path, format: TrackFormat) -> Result<Vec<TrackPoint>> {
+    Ok(read_track_table(path, format)?.points)
+}
+
+/// Reads a whole track table of `format` at `path`, with the layout its columns had.
+pub fn read_track_table(path: &Path, format: TrackFormat) -> Result<TrackTable> {
     match format {
         TrackFormat::Tractrac => text::read_tractrac(path),
         TrackFormat::Csv => text::read_csv(path),

@@ -1,37 +1,44 @@
 //! Parquet track tables: the CSV's column names, `frame`/`particle` as Int64, the other
-//! columns Float64 (nullable for the kinematics), zstd-compressed, one row group per
-//! [`ROW_GROUP_ROWS`] rows so memory stays bounded. Readable by pandas/pyarrow directly.
+//! columns Float64 (nullable for the kinematics); with the state layout also `class` UInt32,
+//! `motion_state` Utf8 (the state's name) and `spread_px` Float64 (nullable). zstd-compressed,
+//! one row group per [`ROW_GROUP_ROWS`] rows so memory stays bounded. Readable by
+//! pandas/pyarrow directly.
 
 use std::fs::File;
 use std::path::Path;
 use std::sync::Arc;
 
-use arrow_array::types::{Float64Type, Int64Type};
-use arrow_array::{Array, ArrayRef, Float64Array, Int64Array, RecordBatch, cast::AsArray};
+use arrow_array::types::{Float64Type, Int64Type, UInt32Type};
+use arrow_array::{
+    Array, ArrayRef, Float64Array, Int64Array, RecordBatch, StringArray, UInt32Array, cast::AsArray,
+};
 use arrow_schema::{DataType, Field, Schema, SchemaRef};
 use parquet::arrow::ArrowWriter;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use parquet::basic::{Compression, ZstdLevel};
 use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
-use sillage_core::{Error, Result, TrackPoint, TrackSink};
+use sillage_core::{Error, MotionState, Result, TrackPoint, TrackSink};
 
 use super::column_buffer::TrackColumns;
-use super::columns::TRACK_COLUMNS;
-use super::{TrackFileHeader, TrackWriter, WrittenSummary};
+use super::columns::{STATE_COLUMNS, TRACK_COLUMNS, TrackLayout};
+use super::{TrackFileHeader, TrackTable, TrackWriter, WrittenSummary};
 use crate::partial::PartialFile;
 
 /// Rows buffered before a row group is written.
 const ROW_GROUP_ROWS: usize = 65_536;
 
-fn schema() -> SchemaRef {
-    let fields: Vec<Field> = TRACK_COLUMNS
-        .iter()
+fn schema(layout: TrackLayout) -> SchemaRef {
+    let fields: Vec<Field> = layout
+        .columns()
+        .into_iter()
         .enumerate()
         .map(|(i, name)| match i {
-            0 | 1 => Field::new(*name, DataType::Int64, false),
-            2 | 3 => Field::new(*name, DataType::Float64, false),
-            _ => Field::new(*name, DataType::Float64, true),
+            0 | 1 => Field::new(name, DataType::Int64, false),
+            2 | 3 => Field::new(name, DataType::Float64, false),
+            11 => Field::new(name, DataType::UInt32, false),
+            12 => Field::new(name, DataType::Utf8, false),
+            _ => Field::new(name, DataType::Float64, true),
         })
         .collect();
     Arc::new(Schema::new(fields))
@@ -45,6 +52,7 @@ fn parquet_error(path: &Path, action: &str, error: impl std::fmt::Display) -> Er
 pub(crate) struct ParquetTrackWriter {
     writer: ArrowWriter<PartialFile>,
     schema: SchemaRef,
+    layout: TrackLayout,
     buffer: TrackColumns,
     rows: u64,
     partial: std::path::PathBuf,
@@ -80,12 +88,13 @@ impl ParquetTrackWriter {
             .set_max_row_group_row_count(Some(ROW_GROUP_ROWS))
             .set_key_value_metadata(Some(metadata))
             .build();
-        let schema = schema();
+        let schema = schema(header.layout);
         let writer = ArrowWriter::try_new(file, schema.clone(), Some(properties))
             .map_err(|e| parquet_error(&partial, "start", e))?;
         Ok(Self {
             writer,
             schema,
+            layout: header.layout,
             buffer: TrackColumns::default(),
             rows: 0,
             partial,
@@ -108,6 +117,14 @@ impl ParquetTrackWriter {
                 .iter()
                 .map(|c| Arc::new(Float64Array::from(c.clone())) as ArrayRef),
         );
+        if self.layout == TrackLayout::WithStates {
+            let names = b.motion_state.iter().map(|s| s.name());
+            arrays.extend([
+                Arc::new(UInt32Array::from(b.class.clone())) as ArrayRef,
+                Arc::new(StringArray::from_iter_values(names)),
+                Arc::new(Float64Array::from(b.spread_px.clone())),
+            ]);
+        }
         let batch = RecordBatch::try_new(self.schema.clone(), arrays)
             .map_err(|e| parquet_error(&self.partial, "assemble", e))?;
         self.writer
@@ -149,13 +166,15 @@ impl TrackWriter for ParquetTrackWriter {
 }
 
 /// Reads a Parquet track table. `frame`, `particle`, `x`, `y` are required; integer and
-/// float columns of other widths are converted.
-pub(crate) fn read_parquet(path: &Path) -> Result<Vec<TrackPoint>> {
+/// float columns of other widths are converted. The layout is [`TrackLayout::WithStates`]
+/// when the table has a `motion_state` column.
+pub(crate) fn read_parquet(path: &Path) -> Result<TrackTable> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
     let reader = ParquetRecordBatchReaderBuilder::try_new(file)
         .and_then(|b| b.build())
         .map_err(|e| parquet_error(path, "read", e))?;
     let mut points = Vec::new();
+    let mut layout = TrackLayout::Kinematics;
     let mut columns = TrackColumns::default();
     for batch in reader {
         let batch = batch.map_err(|e| parquet_error(path, "read", e))?;
@@ -205,9 +224,39 @@ pub(crate) fn read_parquet(path: &Path) -> Result<Vec<TrackPoint>> {
                 None => vec![None; batch.num_rows()],
             };
         }
+        columns.default_states();
+        let [class, motion_state, spread] = STATE_COLUMNS;
+        if let Some(array) = column(class, &DataType::UInt32)? {
+            // A negative or too large class casts to null.
+            no_nulls(path, class, &array)?;
+            columns.class = array.as_primitive::<UInt32Type>().values().to_vec();
+        }
+        if let Some(array) = column(motion_state, &DataType::Utf8)? {
+            layout = TrackLayout::WithStates;
+            let first_row = points.len() + 1;
+            for (i, name) in array.as_string::<i32>().iter().enumerate() {
+                columns.motion_state[i] = match name {
+                    None => MotionState::Unknown,
+                    Some(name) => MotionState::from_name(name).ok_or_else(|| {
+                        Error::format(
+                            path,
+                            None,
+                            format!(
+                                "row {}: `motion_state` = `{name}`; it is resting, rolling, \
+                                 saltating or unknown",
+                                first_row + i
+                            ),
+                        )
+                    })?,
+                };
+            }
+        }
+        if let Some(array) = column(spread, &DataType::Float64)? {
+            columns.spread_px = array.as_primitive::<Float64Type>().iter().collect();
+        }
         points.extend(columns.to_points(path, points.len() + 1)?);
     }
-    Ok(points)
+    Ok(TrackTable { points, layout })
 }
 
 fn no_nulls(path: &Path, name: &str, array: &ArrayRef) -> Result<()> {
@@ -218,7 +267,8 @@ fn no_nulls(path: &Path, name: &str, array: &ArrayRef) -> Result<()> {
             path,
             None,
             format!(
-                "column `{name}` has {} missing values; it is required in every row",
+                "column `{name}` has {} missing or out-of-range values; it is required in \
+                 every row",
                 array.null_count()
             ),
         ))

@@ -5,10 +5,13 @@ use std::fmt::Write as _;
 use std::io::BufRead;
 use std::path::Path;
 
-use sillage_core::{Error, Point2, Result, TrackPoint, TrackSink};
+use sillage_core::{Error, MotionState, Point2, Result, TrackPoint, TrackSink};
 
-use super::columns::{TRACK_COLUMNS, check_position, kinematics, point_from_values};
-use super::{TrackFileHeader, TrackWriter, WrittenSummary};
+use super::columns::{
+    STATE_COLUMNS, TRACK_COLUMNS, TrackLayout, check_position, class_from_value, kinematics,
+    point_from_values,
+};
+use super::{TrackFileHeader, TrackTable, TrackWriter, WrittenSummary};
 use crate::text_table::{CsvTable, RowWriter, parse_index, push_opt};
 
 /// The column line of TracTrac's `_track.txt` (its third header line, after `#  `).
@@ -24,8 +27,8 @@ const TRACTRAC_DECIMALS: [usize; 9] = [3, 3, 5, 5, 4, 4, 4, 4, 3];
 pub(crate) enum TextStyle {
     /// TracTrac's `_track.txt`.
     Tractrac,
-    /// CSV with [`TRACK_COLUMNS`].
-    Csv,
+    /// CSV with the columns of the layout.
+    Csv(TrackLayout),
 }
 
 impl TextStyle {
@@ -38,7 +41,7 @@ impl TextStyle {
                 header.program_version,
                 python_dict(&header.parameters)
             ),
-            Self::Csv => format!("{}\n", TRACK_COLUMNS.join(",")),
+            Self::Csv(layout) => format!("{}\n", layout.columns().join(",")),
         }
     }
 
@@ -61,7 +64,7 @@ impl TextStyle {
                     }
                 }
             }
-            Self::Csv => {
+            Self::Csv(layout) => {
                 let _ = write!(
                     out,
                     "{},{},{},{}",
@@ -70,6 +73,10 @@ impl TextStyle {
                 for value in values {
                     out.push(',');
                     push_opt(out, value);
+                }
+                if layout == TrackLayout::WithStates {
+                    let _ = write!(out, ",{},{},", point.class, point.motion_state.name());
+                    push_opt(out, point.spread_px.filter(|s| s.is_finite()));
                 }
             }
         }
@@ -124,7 +131,7 @@ impl TrackWriter for TextTrackWriter {
 
 /// Reads TracTrac's `_track.txt`: `#` lines skipped, 11 space-separated columns, `nan` for
 /// unknown kinematics.
-pub(crate) fn read_tractrac(path: &Path) -> Result<Vec<TrackPoint>> {
+pub(crate) fn read_tractrac(path: &Path) -> Result<TrackTable> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let mut points = Vec::new();
     for (i, line) in std::io::BufReader::new(file).lines().enumerate() {
@@ -144,7 +151,10 @@ pub(crate) fn read_tractrac(path: &Path) -> Result<Vec<TrackPoint>> {
             )
         })?);
     }
-    Ok(points)
+    Ok(TrackTable {
+        points,
+        layout: TrackLayout::Kinematics,
+    })
 }
 
 fn parse_tractrac_row(text: &str) -> std::result::Result<TrackPoint, String> {
@@ -179,16 +189,19 @@ fn parse_tractrac_row(text: &str) -> std::result::Result<TrackPoint, String> {
     Ok(point_from_values(frame, id, pos, rest))
 }
 
-/// Reads a CSV track table (columns found by name; the kinematic ones are optional, so a
-/// trackpy `frame,particle,x,y` table is read too).
-pub(crate) fn read_csv(path: &Path) -> Result<Vec<TrackPoint>> {
-    let [frame, particle, x, y, rest @ ..] = TRACK_COLUMNS;
+/// Reads a CSV track table (columns found by name; the kinematic and state ones are
+/// optional, so a trackpy `frame,particle,x,y` table is read too). The layout is
+/// [`TrackLayout::WithStates`] when the table has a `motion_state` column.
+pub(crate) fn read_csv(path: &Path) -> Result<TrackTable> {
+    let [frame, particle, x, y, kinematic @ ..] = TRACK_COLUMNS;
+    let optional: Vec<&'static str> = kinematic.iter().chain(&STATE_COLUMNS).copied().collect();
     let table = CsvTable::open(
         path,
         &[frame, particle, x, y],
-        &rest,
-        &TRACK_COLUMNS.join(","),
+        &optional,
+        &TrackLayout::WithStates.columns().join(","),
     )?;
+    let [class, motion_state, spread] = [11, 12, 13];
     let mut points = Vec::new();
     table.for_each_row(|row| {
         let pos = Point2::new(row.finite(2)?, row.finite(3)?);
@@ -196,10 +209,28 @@ pub(crate) fn read_csv(path: &Path) -> Result<Vec<TrackPoint>> {
         for (k, slot) in rest.iter_mut().enumerate() {
             *slot = row.optional(4 + k)?;
         }
-        points.push(point_from_values(row.index(0)?, row.index(1)?, pos, rest));
+        let mut point = point_from_values(row.index(0)?, row.index(1)?, pos, rest);
+        if table.has(class) {
+            point.class = class_from_value(row.index(class)?)
+                .map_err(|e| row.error(format!("{e}; fix or remove the row")))?;
+        }
+        if let Some(name) = row.text(motion_state) {
+            point.motion_state = MotionState::from_name(name).ok_or_else(|| {
+                row.error(format!(
+                    "`motion_state` = `{name}`; it is resting, rolling, saltating or unknown"
+                ))
+            })?;
+        }
+        point.spread_px = row.optional(spread)?.filter(|s| s.is_finite());
+        points.push(point);
         Ok(())
     })?;
-    Ok(points)
+    let layout = if table.has(motion_state) {
+        TrackLayout::WithStates
+    } else {
+        TrackLayout::Kinematics
+    };
+    Ok(TrackTable { points, layout })
 }
 
 #[cfg(test)]
@@ -219,8 +250,17 @@ mod tests {
             "3 17 10.123 -2.500 0.12346 -1.00000 nan nan nan nan -0.457"
         );
         out.clear();
-        TextStyle::Csv.row(&mut out, &point).unwrap();
+        TextStyle::Csv(TrackLayout::Kinematics)
+            .row(&mut out, &point)
+            .unwrap();
         assert_eq!(out, "3,17,10.12345,-2.5,0.123456,-1,,,,,-0.4567");
+        out.clear();
+        point.class = 1;
+        point.motion_state = MotionState::Rolling;
+        TextStyle::Csv(TrackLayout::WithStates)
+            .row(&mut out, &point)
+            .unwrap();
+        assert_eq!(out, "3,17,10.12345,-2.5,0.123456,-1,,,,,-0.4567,1,rolling,");
     }
 
     #[test]
