@@ -278,3 +278,46 @@ fn read_image_reads_a_mask_and_names_bad_files() {
         Err(Error::Io { .. })
     ));
 }
+
+/// BeadTracking's flume-base mask: a 1-bit TIFF with CCITT modified Huffman compression
+/// (TIFF compression 2), 54 strips of 6 rows.
+const CCITT_MASK: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../../shared/data/bedload_beads_lafaye2018/sequence_base_mask.tif"
+);
+
+#[test]
+fn ccitt_modified_huffman_tiff_matches_its_png_conversion() {
+    let mask = read_image(CCITT_MASK).unwrap();
+    // The same mask converted to PNG by another decoder (Pillow, libtiff's).
+    let png = read_image(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../sillage-detect/tests/data/sequence_base_mask.png"
+    ))
+    .unwrap();
+    assert_eq!((mask.width(), mask.height()), (1280, 320));
+    assert_eq!(mask.as_slice(), png.as_slice());
+    let base = mask.as_slice().iter().filter(|&&v| v == 1.0).count();
+    assert!(
+        mask.as_slice().iter().all(|&v| v == 0.0 || v == 1.0),
+        "a bi-level image"
+    );
+    // The flume base is a band at the bottom of the frame: some of it, not most.
+    assert!((10_000..200_000).contains(&base), "{base} base pixels");
+}
+
+#[test]
+fn damaged_ccitt_tiff_names_the_file_and_the_row() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = std::fs::read(CCITT_MASK).unwrap();
+    // Overwrite the coded data of the first strip (data starts after the 8-byte header)
+    // with bits that are no T.4 code.
+    bytes[8..40].fill(0);
+    let path = dir.path().join("mask.tif");
+    std::fs::write(&path, &bytes).unwrap();
+    let error = read_image(&path).unwrap_err().to_string();
+    assert!(
+        error.contains("mask.tif") && error.contains("row 1"),
+        "{error}"
+    );
+}

@@ -1,4 +1,5 @@
-//! Decoding one image file (PNG, JPEG, single-page TIFF) or one TIFF page into a [`GrayImage`].
+//! Decoding one image file (PNG, JPEG, single-page TIFF) or one TIFF page into a [`GrayImage`]
+//! (1-bit TIFFs with CCITT modified Huffman compression through [`super::ccitt`]).
 //!
 //! Grey levels are normalised to `[0, 1]`: 8-bit values are divided by 255, 16-bit by 65535;
 //! 32/64-bit float grey is kept as is. Colour is converted to grey with the Rec. 601 luma
@@ -10,6 +11,8 @@ use std::path::Path;
 use sillage_core::{GrayImage, Result};
 use tiff::ColorType;
 use tiff::decoder::{Decoder, DecodingResult};
+
+use super::ccitt;
 
 /// Rec. 601 luma weights for R, G, B.
 const LUMA_601: [f32; 3] = [0.299, 0.587, 0.114];
@@ -68,6 +71,12 @@ pub(crate) fn file_dimensions(path: &Path) -> DecodeResult<(usize, usize)> {
 pub(crate) fn decode_tiff_page<R: std::io::Read + std::io::Seek>(
     decoder: &mut Decoder<R>,
 ) -> DecodeResult<GrayImage> {
+    let compression = decoder
+        .find_tag_unsigned::<u16>(tiff::tags::Tag::Compression)
+        .map_err(|e| e.to_string())?;
+    if compression == Some(ccitt::MODIFIED_HUFFMAN) {
+        return ccitt::decode_modified_huffman(decoder);
+    }
     let (w, h) = decoder.dimensions().map_err(|e| e.to_string())?;
     let colour = decoder.colortype().map_err(|e| e.to_string())?;
     let channels = match colour {

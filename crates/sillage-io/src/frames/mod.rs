@@ -2,6 +2,7 @@
 //! videos (through the `ffmpeg` program), decoded on a background thread with a bounded
 //! read-ahead queue so memory stays bounded whatever the length of the sequence.
 
+mod ccitt;
 mod decode;
 mod encode;
 mod input;
