@@ -1,6 +1,7 @@
 //! Detectors built from `sillage-image`: TracTrac's blob detector (DoG/LoG, threshold, local
 //! maxima, sub-pixel fit) and the frame pre-processing in front of it (median filter,
-//! background subtraction, mask).
+//! background subtraction, mask); the bedload bead detectors; the motion detector (Gaussian
+//! mixture background, person-sized blobs) of the pedestrian trackers.
 //!
 //! Both are deterministic, validate their parameters once at construction (errors name the
 //! key and its allowed range) and reuse their buffers from frame to frame.
@@ -35,9 +36,11 @@
 
 pub mod bead;
 pub mod blob;
+pub mod motion;
 pub mod preprocess;
 
 pub use bead::{BeadDetections, BeadDetector, BeadGeometry, BeadParams};
 pub use blob::{BlobDetector, BlobFilter, BlobParams, DEFAULT_NOISE_K, Threshold};
+pub use motion::{MotionBlob, MotionDetector, MotionParams};
 pub use preprocess::{BackgroundParams, PreprocessParams, Preprocessor};
 pub use sillage_image::{MedianSize, Polarity, Roi, SubpixelFit};

@@ -1,5 +1,5 @@
 //! Connected components of a binary mask (8-connectivity, MATLAB's `regionprops` default) with
-//! their area and centroid.
+//! their area, centroid and bounding box.
 //!
 //! Fast method: run-based union–find. Each row is cut into runs of set pixels; a run is merged
 //! with the runs of the row above that touch it (overlap extended by one column for diagonal
@@ -15,6 +15,52 @@ pub struct Component {
     pub area: usize,
     /// Mean of the pixel coordinates, px (sub-pixel).
     pub centroid: Point2,
+    /// The smallest box holding every pixel.
+    pub bbox: PixelBox,
+}
+
+/// An axis-aligned box of whole pixels, half-open: columns `x0..x1`, rows `y0..y1`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct PixelBox {
+    /// First column.
+    pub x0: usize,
+    /// First row.
+    pub y0: usize,
+    /// One past the last column.
+    pub x1: usize,
+    /// One past the last row.
+    pub y1: usize,
+}
+
+impl PixelBox {
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.x1 - self.x0
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.y1 - self.y0
+    }
+
+    /// The smallest box holding both.
+    pub fn union(&self, other: &PixelBox) -> PixelBox {
+        PixelBox {
+            x0: self.x0.min(other.x0),
+            y0: self.y0.min(other.y0),
+            x1: self.x1.max(other.x1),
+            y1: self.y1.max(other.y1),
+        }
+    }
+
+    /// Whether the boxes overlap or lie within `gap_px` pixels of each other (a gap of
+    /// `gap_px` empty columns or rows or fewer between them).
+    pub fn within(&self, other: &PixelBox, gap_px: usize) -> bool {
+        self.x0 <= other.x1 + gap_px
+            && other.x0 <= self.x1 + gap_px
+            && self.y0 <= other.y1 + gap_px
+            && other.y0 <= self.y1 + gap_px
+    }
 }
 
 /// A run of set pixels `x0..x1` in row `y`, and its union–find parent (an index into the runs).
@@ -31,7 +77,16 @@ struct Run {
 pub struct ComponentLabeller {
     runs: Vec<Run>,
     root_to_component: Vec<usize>,
-    sums: Vec<(usize, f64, f64)>,
+    sums: Vec<RunSums>,
+}
+
+/// What [`ComponentLabeller`] accumulates per component.
+#[derive(Debug, Clone, Copy)]
+struct RunSums {
+    area: usize,
+    sum_x: f64,
+    sum_y: f64,
+    bbox: PixelBox,
 }
 
 impl ComponentLabeller {
@@ -109,22 +164,34 @@ impl ComponentLabeller {
         for j in 0..self.runs.len() {
             let root = find(&mut self.runs, j);
             let run = self.runs[j];
+            let run_box = PixelBox {
+                x0: run.x0,
+                y0: run.y,
+                x1: run.x1,
+                y1: run.y + 1,
+            };
             let slot = &mut self.root_to_component[root];
             if *slot == usize::MAX {
                 *slot = self.sums.len();
-                self.sums.push((0, 0.0, 0.0));
+                self.sums.push(RunSums {
+                    area: 0,
+                    sum_x: 0.0,
+                    sum_y: 0.0,
+                    bbox: run_box,
+                });
             }
             let n = run.x1 - run.x0;
-            // Σx over x0..x1 = n·(x0 + x1 − 1)/2, exact in f64 for any frame size.
-            let sum_x = n as f64 * (run.x0 + run.x1 - 1) as f64 / 2.0;
             let entry = &mut self.sums[*slot];
-            entry.0 += n;
-            entry.1 += sum_x;
-            entry.2 += (n * run.y) as f64;
+            entry.area += n;
+            // Σx over x0..x1 = n·(x0 + x1 − 1)/2, exact in f64 for any frame size.
+            entry.sum_x += n as f64 * (run.x0 + run.x1 - 1) as f64 / 2.0;
+            entry.sum_y += (n * run.y) as f64;
+            entry.bbox = entry.bbox.union(&run_box);
         }
-        out.extend(self.sums.iter().map(|&(area, sx, sy)| Component {
-            area,
-            centroid: Point2::new(sx / area as f64, sy / area as f64),
+        out.extend(self.sums.iter().map(|s| Component {
+            area: s.area,
+            centroid: Point2::new(s.sum_x / s.area as f64, s.sum_y / s.area as f64),
+            bbox: s.bbox,
         }));
     }
 }

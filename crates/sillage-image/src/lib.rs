@@ -59,7 +59,7 @@ pub mod subpixel;
 pub use background::BackgroundModel;
 pub use bandpass::{DogFilter, LogFilter, MAX_SCALE_PX, Polarity};
 pub use box_mean::box_mean_3x3;
-pub use components::{Component, ComponentLabeller};
+pub use components::{Component, ComponentLabeller, PixelBox};
 pub use gaussian::{GaussianFilter, GaussianKernel, MAX_SIGMA_PX};
 pub use mask::{Roi, apply_mask};
 pub use maxima::{Peak, PeakFinder};

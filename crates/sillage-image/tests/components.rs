@@ -1,7 +1,7 @@
 //! Connected components against a flood fill.
 
 use sillage_core::{Image, Point2};
-use sillage_image::{Component, ComponentLabeller};
+use sillage_image::{Component, ComponentLabeller, PixelBox};
 
 /// Components by 8-connected flood fill, in order of first pixel.
 fn reference(mask: &Image<bool>) -> Vec<Component> {
@@ -13,12 +13,24 @@ fn reference(mask: &Image<bool>) -> Vec<Component> {
             continue;
         }
         let (mut stack, mut area, mut sx, mut sy) = (vec![start], 0, 0.0, 0.0);
+        let mut bbox = PixelBox {
+            x0: w,
+            y0: h,
+            x1: 0,
+            y1: 0,
+        };
         seen[start] = true;
         while let Some(p) = stack.pop() {
             let (x, y) = (p % w, p / w);
             area += 1;
             sx += x as f64;
             sy += y as f64;
+            bbox = bbox.union(&PixelBox {
+                x0: x,
+                y0: y,
+                x1: x + 1,
+                y1: y + 1,
+            });
             for yy in y.saturating_sub(1)..(y + 2).min(h) {
                 for xx in x.saturating_sub(1)..(x + 2).min(w) {
                     let q = yy * w + xx;
@@ -32,6 +44,7 @@ fn reference(mask: &Image<bool>) -> Vec<Component> {
         out.push(Component {
             area,
             centroid: Point2::new(sx / area as f64, sy / area as f64),
+            bbox,
         });
     }
     out
@@ -57,6 +70,7 @@ fn matches_flood_fill_on_random_masks() {
         assert_eq!(got.len(), want.len());
         for (g, r) in got.iter().zip(&want) {
             assert_eq!(g.area, r.area);
+            assert_eq!(g.bbox, r.bbox);
             assert!(g.centroid.distance(r.centroid) < 1e-9);
         }
     }
