@@ -18,6 +18,9 @@
 //!   0, but the prefixes stay small: two reads per vertical run of ring pixels (36 runs for
 //!   BeadTracking's 21×21 template) instead of 204 reads, accumulated in registers over
 //!   chunks of 64 pixels. [`RingCorrelator::apply`] states the resulting error bound.
+//!
+//! 8-bit levels: [`RingCorrelator::apply_levels`] computes every sum exactly in integers (the
+//! ring sums in wrapping 16-bit lanes), see `levels.rs`.
 
 mod levels;
 
