@@ -5,11 +5,11 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use sillage_core::GrayImage;
+use sillage_core::{GrayImage, Image};
 use sillage_detect::{BeadDetections, BeadDetector, BeadParams};
 use sillage_image::{
     Morphology, PeakFinder, Reconstruction, RingCorrelator, RingTemplate, StructuringElement,
-    box_mean_3x3,
+    box_mean_3x3, encode_levels,
 };
 use sillage_io::read_image;
 
@@ -85,6 +85,33 @@ fn bench_bead(c: &mut Criterion) {
             box_mean_3x3(black_box(&correlation), &mut a);
             box_mean_3x3(&a, &mut t);
         })
+    });
+    // The levels path of 8-bit frames (what the detector runs on the real frames).
+    let (mut levels, mut out) = (Image::default(), Image::default());
+    assert!(encode_levels(&frame, &mut levels));
+    group.bench_function("dilate_disk8_levels", |b| {
+        b.iter(|| morphology.dilate_levels(black_box(&levels), &disk8, &mut out))
+    });
+    group.bench_function("close_disk22_levels", |b| {
+        b.iter(|| morphology.close_levels(black_box(&levels), &disk22, &mut out))
+    });
+    let top_hat_levels = Image::from_vec(
+        frame.width(),
+        frame.height(),
+        top_hat
+            .as_slice()
+            .iter()
+            .map(|&v| (v * 255.0).round() as u8)
+            .collect(),
+    )
+    .unwrap();
+    group.bench_function("h_concave_levels", |b| {
+        b.iter(|| reconstruction.h_concave_levels(black_box(&top_hat_levels), 44, &mut out))
+    });
+    let mut concave_levels = Image::default();
+    reconstruction.h_concave_levels(&top_hat_levels, 44, &mut concave_levels);
+    group.bench_function("ring_ncc_levels", |b| {
+        b.iter(|| correlator.apply_levels(black_box(&concave_levels), &mut t))
     });
     box_mean_3x3(&correlation, &mut a);
     box_mean_3x3(&a, &mut t);

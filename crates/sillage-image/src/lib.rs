@@ -10,6 +10,7 @@
 //! - [`stats`]: thread-count-independent mean and standard deviation, and a robust noise
 //!   level (median and MAD of a fixed subsample);
 //! - [`background`]: TracTrac's slew-limited background model (Eqs. (1)–(2));
+//! - [`levels`]: 8-bit grey levels, encoded from and decoded to `f32` frames;
 //! - [`mask`]: masks and rectangular regions of interest ([`Roi`]).
 //!
 //! Filters own their scratch buffers, so processing frame after frame allocates nothing once
@@ -45,6 +46,7 @@ pub mod bandpass;
 pub mod box_mean;
 pub mod components;
 pub mod gaussian;
+pub mod levels;
 pub mod mask;
 pub mod maxima;
 pub mod median;
@@ -61,6 +63,7 @@ pub use bandpass::{DogFilter, LogFilter, MAX_SCALE_PX, Polarity};
 pub use box_mean::box_mean_3x3;
 pub use components::{Component, ComponentLabeller, PixelBox};
 pub use gaussian::{GaussianFilter, GaussianKernel, MAX_SIGMA_PX};
+pub use levels::{decode_levels, encode_levels};
 pub use mask::{Roi, apply_mask};
 pub use maxima::{Peak, PeakFinder};
 pub use median::{MedianSize, median_filter};

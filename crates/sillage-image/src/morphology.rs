@@ -13,14 +13,16 @@
 //! whatever the number of threads and whichever SIMD path runs.
 //!
 //! 8-bit frames: when every pixel is exactly `k / 255` for an integer `k` (what 8-bit images
-//! decode to, `f32::from(k) / 255.0`), the passes run on the bytes `k` instead — four times
+//! decode to, see [`crate::levels`]), the passes run on the bytes `k` instead — four times
 //! the lanes per vector and a quarter of the memory traffic — and the result is decoded back
 //! the same way. `min`/`max` commute with this increasing map, so the result is bit-identical
-//! to the `f32` path; other images take the `f32` path.
+//! to the `f32` path; other images take the `f32` path. Callers that hold the levels already
+//! use the `*_levels` methods, with no encoding or decoding at all.
 
 use rayon::prelude::*;
-use sillage_core::GrayImage;
+use sillage_core::{GrayImage, Image};
 
+use crate::levels::{decode_levels, encode_levels};
 use crate::structuring::{Step, StructuringElement};
 
 /// Output rows per tile (and per parallel band).
@@ -98,87 +100,15 @@ impl<'a, T> Plane<'a, T> {
     }
 }
 
-/// Writes into `bytes` the `k` of each pixel `f32::from(k) / 255.0` of `src`; false (and
-/// `bytes` unspecified) as soon as a pixel is not exactly such a value.
-fn encode_bytes(src: &[f32], bytes: &mut Vec<u8>) -> bool {
-    bytes.resize(src.len(), 0);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512bw") {
-            // SAFETY: the CPU supports AVX-512F and AVX-512BW, checked just above.
-            return unsafe { encode_avx512(src, bytes) };
-        }
-    }
-    encode(src, bytes)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512bw")]
-fn encode_avx512(src: &[f32], bytes: &mut [u8]) -> bool {
-    encode(src, bytes)
-}
-
-/// 1.5·2²³: `x + ROUNDING_SHIFT` has `round(x)` in its low mantissa bits for `|x| < 2²²`.
-const ROUNDING_SHIFT: f32 = 12_582_912.0;
-
-/// See [`encode_bytes`]; `bytes` has the length of `src`.
-#[inline(always)]
-fn encode(src: &[f32], bytes: &mut [u8]) -> bool {
-    const CHUNK: usize = 64;
-    for (values, out) in src.chunks(CHUNK).zip(bytes.chunks_mut(CHUNK)) {
-        let mut exact = true;
-        for (&v, b) in values.iter().zip(out.iter_mut()) {
-            // The nearest level for values in [0, 1]: adding 1.5·2²³ rounds `255·v` to an
-            // integer held in the low mantissa bits (plain bit operations, which vectorise,
-            // where a saturating float-to-int cast does not). Anything else (NaN, negative,
-            // above 1, between levels) gives some byte that fails the check below.
-            let k = ((v * 255.0 + ROUNDING_SHIFT).to_bits() & 0xff) as u8;
-            exact &= (f32::from(k) / 255.0).to_bits() == v.to_bits();
-            *b = k;
-        }
-        if !exact {
-            return false;
-        }
-    }
-    true
-}
-
-/// `dst = f32::from(k) / 255.0` for each byte `k` (the values [`encode_bytes`] read).
-fn decode_bytes(bytes: &[u8], dst: &mut [f32]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512bw") {
-            // SAFETY: the CPU supports AVX-512F and AVX-512BW, checked just above.
-            unsafe { decode_avx512(bytes, dst) };
-            return;
-        }
-    }
-    decode(bytes, dst);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512bw")]
-fn decode_avx512(bytes: &[u8], dst: &mut [f32]) {
-    decode(bytes, dst);
-}
-
-/// See [`decode_bytes`].
-#[inline(always)]
-fn decode(bytes: &[u8], dst: &mut [f32]) {
-    for (d, &k) in dst.iter_mut().zip(bytes) {
-        *d = f32::from(k) / 255.0;
-    }
-}
-
 /// Grey-level morphology with reusable buffers: once they have grown to a frame's size,
 /// processing more frames allocates nothing.
 #[derive(Debug, Clone, Default)]
 pub struct Morphology {
     scratch: Vec<f32>,
     intermediate: GrayImage,
-    /// The 8-bit path's source, intermediate and result bytes and its tile scratch.
-    bytes: [Vec<u8>; 3],
-    scratch_bytes: Vec<u8>,
+    /// The 8-bit path's source, intermediate and result levels.
+    levels: [Image<u8>; 3],
+    scratch_levels: Vec<u8>,
 }
 
 impl Morphology {
@@ -209,54 +139,65 @@ impl Morphology {
         self.run(src, se, dst, &[false, true]);
     }
 
+    /// [`Morphology::dilate`] on 8-bit levels (`dst` is reshaped): the levels of the dilation
+    /// of the decoded image.
+    pub fn dilate_levels(&mut self, src: &Image<u8>, se: &StructuringElement, dst: &mut Image<u8>) {
+        let [_, middle, _] = &mut self.levels;
+        run_ops(src, se, dst, &[true], middle, &mut self.scratch_levels);
+    }
+
+    /// [`Morphology::close`] on 8-bit levels (`dst` is reshaped): the levels of the closing
+    /// of the decoded image.
+    pub fn close_levels(&mut self, src: &Image<u8>, se: &StructuringElement, dst: &mut Image<u8>) {
+        let [_, middle, _] = &mut self.levels;
+        run_ops(
+            src,
+            se,
+            dst,
+            &[true, false],
+            middle,
+            &mut self.scratch_levels,
+        );
+    }
+
     /// Dilations (`true`) and erosions (`false`) by `se` one after the other (one or two), on
-    /// the bytes of an 8-bit image when `src` is one, else on `f32`.
+    /// the levels of an 8-bit image when `src` is one, else on `f32`.
     fn run(&mut self, src: &GrayImage, se: &StructuringElement, dst: &mut GrayImage, ops: &[bool]) {
-        let (width, height) = src.dimensions();
-        dst.reshape(width, height);
-        let plane = |data| Plane {
-            data,
-            width,
-            height,
-        };
-        let plane_f32 = |data| Plane {
-            data,
-            width,
-            height,
-        };
-        let [source, middle, result] = &mut self.bytes;
-        if encode_bytes(src.as_slice(), source) {
-            middle.resize(source.len(), 0);
-            result.resize(source.len(), 0);
-            let scratch = &mut self.scratch_bytes;
-            match *ops {
-                [op] => apply_op(op, plane(source), se, result, scratch),
-                [a, b] => {
-                    apply_op(a, plane(source), se, middle, scratch);
-                    apply_op(b, plane(middle), se, result, scratch);
-                }
-                _ => unreachable!("one or two operations"),
-            }
-            decode_bytes(result, dst.as_mut_slice());
-            return;
+        let [source, middle, result] = &mut self.levels;
+        if encode_levels(src, source) {
+            run_ops(source, se, result, ops, middle, &mut self.scratch_levels);
+            decode_levels(result, dst);
+        } else {
+            run_ops(src, se, dst, ops, &mut self.intermediate, &mut self.scratch);
         }
-        let scratch = &mut self.scratch;
-        match *ops {
-            [op] => apply_op(
-                op,
-                plane_f32(src.as_slice()),
-                se,
-                dst.as_mut_slice(),
-                scratch,
-            ),
-            [a, b] => {
-                self.intermediate.reshape(width, height);
-                let middle = self.intermediate.as_mut_slice();
-                apply_op(a, plane_f32(src.as_slice()), se, middle, scratch);
-                apply_op(b, plane_f32(middle), se, dst.as_mut_slice(), scratch);
-            }
-            _ => unreachable!("one or two operations"),
+    }
+}
+
+/// `ops` (one or two: dilation `true`, erosion `false`) by `se` on `src` into `dst`
+/// (reshaped), through `middle` when there are two.
+fn run_ops<T: Lane>(
+    src: &Image<T>,
+    se: &StructuringElement,
+    dst: &mut Image<T>,
+    ops: &[bool],
+    middle: &mut Image<T>,
+    scratch: &mut Vec<T>,
+) {
+    let (width, height) = src.dimensions();
+    dst.reshape(width, height);
+    let plane = |data| Plane {
+        data,
+        width,
+        height,
+    };
+    match *ops {
+        [op] => apply_op(op, plane(src.as_slice()), se, dst.as_mut_slice(), scratch),
+        [a, b] => {
+            middle.reshape(width, height);
+            apply_op(a, plane(src.as_slice()), se, middle.as_mut_slice(), scratch);
+            apply_op(b, plane(middle.as_slice()), se, dst.as_mut_slice(), scratch);
         }
+        _ => unreachable!("one or two operations"),
     }
 }
 
@@ -491,56 +432,46 @@ fn pass<T: Lane, O: Extremum>(
 mod tests {
     use super::*;
 
-    /// Images of 8-bit levels take the byte path, other images the `f32` one, and both give
-    /// the same bits (the increasing map `k ↦ k / 255` commutes with min and max).
+    /// The `f32` passes alone, with no check for levels: the reference of the byte paths.
+    fn f32_passes(src: &GrayImage, se: &StructuringElement, ops: &[bool]) -> GrayImage {
+        let (mut dst, mut middle) = (GrayImage::default(), GrayImage::default());
+        run_ops(src, se, &mut dst, ops, &mut middle, &mut Vec::new());
+        dst
+    }
+
+    /// Images of 8-bit levels take the byte path (from `f32` frames or from the levels
+    /// directly), other images the `f32` one, and all give the same bits (the increasing map
+    /// `k ↦ k / 255` commutes with min and max).
     #[test]
-    fn byte_path_matches_the_f32_path_bit_for_bit() {
+    fn byte_paths_match_the_f32_path_bit_for_bit() {
         let (w, h) = (333, 190);
         let levels: Vec<f32> = (0..w * h)
             .map(|i| f32::from(((i * 7919 + i / w * 31) % 256) as u8) / 255.0)
             .collect();
-        let src = GrayImage::from_vec(w, h, levels.clone()).unwrap();
-        let mut bytes = Vec::new();
-        assert!(encode_bytes(src.as_slice(), &mut bytes));
-        let mut nudged = levels;
-        nudged[w * h / 2] = f32::from_bits(nudged[w * h / 2].to_bits() + 1);
-        assert!(!encode_bytes(&nudged, &mut bytes));
-        for bad in [f32::NAN, -0.0, 1.5, -1.0 / 255.0] {
-            assert!(!encode_bytes(&[0.0, bad], &mut bytes), "{bad}");
-        }
+        let src = GrayImage::from_vec(w, h, levels).unwrap();
+        let mut bytes = Image::default();
+        assert!(encode_levels(&src, &mut bytes));
         let mut engine = Morphology::new();
+        let (mut fast, mut fast_levels, mut decoded) =
+            (GrayImage::default(), Image::default(), GrayImage::default());
         for se in [
             StructuringElement::disk(1).unwrap(),
             StructuringElement::disk(8).unwrap(),
             StructuringElement::disk(22).unwrap(),
             StructuringElement::square(5).unwrap(),
         ] {
-            let (mut fast, mut reference) = (GrayImage::default(), GrayImage::default());
+            let reference = f32_passes(&src, &se, &[true, false]);
             engine.close(&src, &se, &mut fast);
-            let plane = Plane {
-                data: src.as_slice(),
-                width: w,
-                height: h,
-            };
-            let mut middle = vec![0.0; w * h];
-            let mut scratch = Vec::new();
-            apply::<f32, Max>(plane, &se, &mut middle, &mut scratch);
-            reference.reshape(w, h);
-            let plane = Plane {
-                data: &middle,
-                width: w,
-                height: h,
-            };
-            apply::<f32, Min>(plane, &se, reference.as_mut_slice(), &mut scratch);
             assert!(fast == reference);
+            engine.close_levels(&bytes, &se, &mut fast_levels);
+            decode_levels(&fast_levels, &mut decoded);
+            assert!(decoded == reference);
+            let reference = f32_passes(&src, &se, &[true]);
             engine.dilate(&src, &se, &mut fast);
-            let plane = Plane {
-                data: src.as_slice(),
-                width: w,
-                height: h,
-            };
-            apply::<f32, Max>(plane, &se, reference.as_mut_slice(), &mut scratch);
             assert!(fast == reference);
+            engine.dilate_levels(&bytes, &se, &mut fast_levels);
+            decode_levels(&fast_levels, &mut decoded);
+            assert!(decoded == reference);
         }
     }
 }

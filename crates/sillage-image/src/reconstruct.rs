@@ -9,10 +9,14 @@
 //! anti-raster scan could still lower, finishes the job; linear in the number of pixels. The
 //! result is the unique fixed point of the propagation (only `min`/`max` of input values), so
 //! it is exact and does not depend on any order.
+//!
+//! 8-bit levels ([`Reconstruction::h_concave_levels`]): the same algorithm on `u16` levels
+//! (the marker `f + h` may exceed 255), 32 lanes per AVX-512 vector instead of 16; since it
+//! only takes `min`/`max`, it gives the levels of the `f32` result on the decoded image.
 
 use std::collections::VecDeque;
 
-use sillage_core::{Error, GrayImage, Result};
+use sillage_core::{Error, GrayImage, Image, Result};
 
 use crate::mask::check_same_size;
 
@@ -29,10 +33,97 @@ enum Direction {
 /// as `(dx, dy)`; the other four are their opposites.
 const BEFORE: [(isize, isize); 4] = [(-1, 0), (-1, -1), (0, -1), (1, -1)];
 
-/// Reconstruction and h-transforms with a reusable queue.
+/// A pixel type the reconstruction runs on: `f32` grey levels or `u16` integer levels.
+trait Level: Copy + PartialOrd + Send + Sync {
+    /// The highest value (+∞ for `f32`): the clamp that leaves everything unchanged.
+    const HIGHEST: Self;
+
+    /// [`scans`] compiled for the widest SIMD this type has a clamp scan for, when the CPU
+    /// has it (the same `min`/`max` results on every path).
+    fn scans_dispatch(r: &mut [Self], m: &[Self], width: usize, queue: &mut VecDeque<usize>);
+
+    /// The SIMD [`clamp_scan`] (full scan, tail included).
+    ///
+    /// # Safety
+    /// Only from inside the function `scans_dispatch` compiles for the SIMD this type uses,
+    /// itself called after the runtime check of that SIMD.
+    unsafe fn simd_clamp_scan(row: &mut [Self], mask: &[Self], direction: Direction);
+}
+
+impl Level for f32 {
+    const HIGHEST: f32 = f32::INFINITY;
+
+    fn scans_dispatch(r: &mut [f32], m: &[f32], width: usize, queue: &mut VecDeque<usize>) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the CPU supports AVX-512F, checked just above.
+                unsafe { scans_avx512f(r, m, width, queue) };
+                return;
+            }
+        }
+        scans::<f32, false>(r, m, width, queue);
+    }
+
+    #[inline(always)]
+    unsafe fn simd_clamp_scan(row: &mut [f32], mask: &[f32], direction: Direction) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: AVX-512F is available (the caller's contract).
+        unsafe {
+            simd::f32x16::clamp_scan(row, mask, direction)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        clamp_scan(row, mask, direction, Self::HIGHEST);
+    }
+}
+
+impl Level for u16 {
+    const HIGHEST: u16 = u16::MAX;
+
+    fn scans_dispatch(r: &mut [u16], m: &[u16], width: usize, queue: &mut VecDeque<usize>) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512bw")
+            {
+                // SAFETY: the CPU supports AVX-512F and AVX-512BW, checked just above.
+                unsafe { scans_avx512bw(r, m, width, queue) };
+                return;
+            }
+        }
+        scans::<u16, false>(r, m, width, queue);
+    }
+
+    #[inline(always)]
+    unsafe fn simd_clamp_scan(row: &mut [u16], mask: &[u16], direction: Direction) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: AVX-512F and AVX-512BW are available (the caller's contract).
+        unsafe {
+            simd::u16x32::clamp_scan(row, mask, direction)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        clamp_scan(row, mask, direction, Self::HIGHEST);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn scans_avx512f(r: &mut [f32], m: &[f32], width: usize, queue: &mut VecDeque<usize>) {
+    scans::<f32, true>(r, m, width, queue);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw")]
+fn scans_avx512bw(r: &mut [u16], m: &[u16], width: usize, queue: &mut VecDeque<usize>) {
+    scans::<u16, true>(r, m, width, queue);
+}
+
+/// Reconstruction and h-transforms with a reusable queue and level buffers.
 #[derive(Debug, Clone, Default)]
 pub struct Reconstruction {
     queue: VecDeque<usize>,
+    /// The marker and the mask of the levels path.
+    marker_levels: Vec<u16>,
+    mask_levels: Vec<u16>,
 }
 
 impl Reconstruction {
@@ -59,7 +150,12 @@ impl Reconstruction {
                  the marker of a reconstruction by erosion must be ≥ the mask everywhere"
             )));
         }
-        self.reconstruct(marker, mask);
+        reconstruct(
+            marker.as_mut_slice(),
+            mask.as_slice(),
+            mask.width(),
+            &mut self.queue,
+        );
         Ok(())
     }
 
@@ -80,40 +176,68 @@ impl Reconstruction {
         for (d, &s) in dst.as_mut_slice().iter_mut().zip(src.as_slice()) {
             *d = s + h;
         }
-        self.reconstruct(dst, src);
+        reconstruct(dst.as_mut_slice(), src.as_slice(), width, &mut self.queue);
         for (d, &s) in dst.as_mut_slice().iter_mut().zip(src.as_slice()) {
             *d -= s;
         }
         Ok(())
     }
 
-    /// The hybrid algorithm on a marker known to be ≥ the mask.
-    fn reconstruct(&mut self, marker: &mut GrayImage, mask: &GrayImage) {
-        let (width, height) = mask.dimensions();
-        if width == 0 || height == 0 {
-            return;
+    /// [`Reconstruction::h_concave`] on 8-bit levels: `dst` (reshaped) holds the levels
+    /// `HMIN_h(f) − f` (each at most `h`) of the levels `f` of `src` — exactly, with no
+    /// rounding (on the decoded image, `h_concave` gives these levels up to the `f32` rounding
+    /// of `f + h` and of the difference).
+    pub fn h_concave_levels(&mut self, src: &Image<u8>, h: u8, dst: &mut Image<u8>) {
+        let (width, height) = src.dimensions();
+        dst.reshape(width, height);
+        let src = src.as_slice();
+        self.mask_levels.clear();
+        self.mask_levels.extend(src.iter().map(|&f| u16::from(f)));
+        self.marker_levels.clear();
+        self.marker_levels
+            .extend(src.iter().map(|&f| u16::from(f) + u16::from(h)));
+        reconstruct(
+            &mut self.marker_levels,
+            &self.mask_levels,
+            width,
+            &mut self.queue,
+        );
+        for ((d, &r), &f) in dst
+            .as_mut_slice()
+            .iter_mut()
+            .zip(&self.marker_levels)
+            .zip(src)
+        {
+            // r − f ≤ h ≤ 255.
+            *d = (r - u16::from(f)) as u8;
         }
-        let r = marker.as_mut_slice();
-        let m = mask.as_slice();
-        self.queue.clear();
-        scans_dispatch(r, m, width, &mut self.queue);
-        // Propagation.
-        let neighbour = |p: usize, (dx, dy): (isize, isize)| {
-            let (x, y) = ((p % width) as isize + dx, (p / width) as isize + dy);
-            (x >= 0 && y >= 0 && (x as usize) < width && (y as usize) < height)
-                .then(|| y as usize * width + x as usize)
-        };
-        while let Some(p) = self.queue.pop_front() {
-            let v = r[p];
-            for (dx, dy) in BEFORE {
-                for offset in [(dx, dy), (-dx, -dy)] {
-                    if let Some(q) = neighbour(p, offset)
-                        && r[q] > v
-                        && r[q] != m[q]
-                    {
-                        r[q] = v.max(m[q]);
-                        self.queue.push_back(q);
-                    }
+    }
+}
+
+/// The hybrid algorithm on a marker `r` known to be ≥ the mask `m` (rows of `width`).
+fn reconstruct<T: Level>(r: &mut [T], m: &[T], width: usize, queue: &mut VecDeque<usize>) {
+    if width == 0 || m.is_empty() {
+        return;
+    }
+    let height = m.len() / width;
+    queue.clear();
+    T::scans_dispatch(r, m, width, queue);
+    // Propagation.
+    let neighbour = |p: usize, (dx, dy): (isize, isize)| {
+        let (x, y) = ((p % width) as isize + dx, (p / width) as isize + dy);
+        (x >= 0 && y >= 0 && (x as usize) < width && (y as usize) < height)
+            .then(|| y as usize * width + x as usize)
+    };
+    while let Some(p) = queue.pop_front() {
+        let v = r[p];
+        for (dx, dy) in BEFORE {
+            for offset in [(dx, dy), (-dx, -dy)] {
+                if let Some(q) = neighbour(p, offset)
+                    && r[q] > v
+                    && r[q] != m[q]
+                {
+                    r[q] = higher(v, m[q]);
+                    queue.push_back(q);
                 }
             }
         }
@@ -121,35 +245,22 @@ impl Reconstruction {
 }
 
 /// The raster and anti-raster scans of `r` over `m` (rows of `width`), queueing what the
-/// propagation must finish; compiled for AVX-512 when the CPU has it.
-fn scans_dispatch(r: &mut [f32], m: &[f32], width: usize, queue: &mut VecDeque<usize>) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU supports AVX-512F, checked just above.
-            unsafe { scans_avx512(r, m, width, queue) };
-            return;
-        }
-    }
-    scans::<false>(r, m, width, queue);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn scans_avx512(r: &mut [f32], m: &[f32], width: usize, queue: &mut VecDeque<usize>) {
-    scans::<true>(r, m, width, queue);
-}
-
-/// See [`scans_dispatch`]; `SIMD` is true only on the AVX-512 path.
+/// propagation must finish; `SIMD` is true only inside the functions compiled for the SIMD
+/// of [`Level::simd_clamp_scan`].
 #[inline(always)]
-fn scans<const SIMD: bool>(r: &mut [f32], m: &[f32], width: usize, queue: &mut VecDeque<usize>) {
+fn scans<T: Level, const SIMD: bool>(
+    r: &mut [T],
+    m: &[T],
+    width: usize,
+    queue: &mut VecDeque<usize>,
+) {
     let height = m.len() / width;
     // Raster scan: R(p) = max(min(R(p), R(q) for the 4 neighbours q before p), mask(p)).
     for y in 0..height {
         let (done, rest) = r.split_at_mut(y * width);
         let row = &mut rest[..width];
         let previous = y.checked_sub(1).map(|_| &done[done.len() - width..]);
-        scan_row::<SIMD>(row, previous, &m[y * width..][..width], Direction::Forward);
+        scan_row::<T, SIMD>(row, previous, &m[y * width..][..width], Direction::Forward);
     }
     // Anti-raster scan, queueing the pixels that can still lower a neighbour after them.
     for y in (0..height).rev() {
@@ -157,20 +268,20 @@ fn scans<const SIMD: bool>(r: &mut [f32], m: &[f32], width: usize, queue: &mut V
         let row = &mut rest[y * width..];
         let next = (y + 1 < height).then(|| (&done[..width], &m[(y + 1) * width..][..width]));
         let mask_row = &m[y * width..][..width];
-        scan_row::<SIMD>(row, next.map(|n| n.0), mask_row, Direction::Backward);
+        scan_row::<T, SIMD>(row, next.map(|n| n.0), mask_row, Direction::Backward);
         queue_row(row, mask_row, next, y * width, queue);
     }
 }
 
 /// `min(a, b)` as one vector instruction (`a` if either is NaN).
 #[inline(always)]
-fn lower(a: f32, b: f32) -> f32 {
+fn lower<T: Level>(a: T, b: T) -> T {
     if b < a { b } else { a }
 }
 
 /// `max(a, b)` as one vector instruction (`a` if either is NaN).
 #[inline(always)]
-fn higher(a: f32, b: f32) -> f32 {
+fn higher<T: Level>(a: T, b: T) -> T {
     if b > a { b } else { a }
 }
 
@@ -184,15 +295,15 @@ fn higher(a: f32, b: f32) -> f32 {
 /// steps) plus one clamp by the carry per 16 pixels, instead of a chain of two dependent
 /// operations per pixel.
 #[inline(always)]
-fn scan_row<const SIMD: bool>(
-    row: &mut [f32],
-    scanned: Option<&[f32]>,
-    mask: &[f32],
+fn scan_row<T: Level, const SIMD: bool>(
+    row: &mut [T],
+    scanned: Option<&[T]>,
+    mask: &[T],
     direction: Direction,
 ) {
     if let Some(scanned) = scanned {
         let n = row.len();
-        let fold = |v: f32, x: usize| {
+        let fold = |v: T, x: usize| {
             let mut v = lower(v, scanned[x]);
             if x > 0 {
                 v = lower(v, scanned[x - 1]);
@@ -207,8 +318,25 @@ fn scan_row<const SIMD: bool>(
             row[n - 1] = fold(row[n - 1], n - 1);
         }
         if n > 2 {
+            // Fixed-size chunks, so that it vectorises for every lane type.
+            const CHUNK: usize = 32;
             let (left, centre, right) = (&scanned[..n - 2], &scanned[1..n - 1], &scanned[2..]);
-            for (((v, &a), &b), &c) in row[1..n - 1].iter_mut().zip(left).zip(centre).zip(right) {
+            let inner = &mut row[1..n - 1];
+            let full = inner.len() / CHUNK * CHUNK;
+            for start in (0..full).step_by(CHUNK) {
+                let v: &mut [T; CHUNK] = (&mut inner[start..start + CHUNK]).try_into().unwrap();
+                let at = |s: &[T]| -> [T; CHUNK] { s[start..start + CHUNK].try_into().unwrap() };
+                let (a, b, c) = (at(left), at(centre), at(right));
+                for i in 0..CHUNK {
+                    v[i] = lower(lower(lower(v[i], a[i]), b[i]), c[i]);
+                }
+            }
+            for (((v, &a), &b), &c) in inner[full..]
+                .iter_mut()
+                .zip(&left[full..])
+                .zip(&centre[full..])
+                .zip(&right[full..])
+            {
                 *v = lower(lower(lower(*v, a), b), c);
             }
         }
@@ -216,24 +344,21 @@ fn scan_row<const SIMD: bool>(
     for (v, &m) in row.iter_mut().zip(mask) {
         *v = higher(*v, m);
     }
-    #[cfg(target_arch = "x86_64")]
-    {
-        if SIMD {
-            // SAFETY: `SIMD` is true only inside `scans_avx512`, called after checking that
-            // the CPU supports AVX-512F.
-            unsafe { simd::clamp_scan(row, mask, direction) };
-            return;
-        }
+    if SIMD {
+        // SAFETY: `SIMD` is true only inside the function `T::scans_dispatch` compiles for
+        // `T`'s SIMD, called after the runtime check of that SIMD.
+        unsafe { T::simd_clamp_scan(row, mask, direction) };
+    } else {
+        clamp_scan(row, mask, direction, T::HIGHEST);
     }
-    clamp_scan(row, mask, direction, f32::INFINITY);
 }
 
 /// `row[x] = clamp(row[x ∓ 1], mask[x], row[x])` along the row in `direction`, one pixel at
 /// a time, starting from `carry` (the value before the first pixel); returns the last value.
 /// The reference the SIMD path must equal, and its tail.
-fn clamp_scan(row: &mut [f32], mask: &[f32], direction: Direction, mut carry: f32) -> f32 {
-    let mut step = |v: &mut f32, m: f32| {
-        *v = carry.max(m).min(*v);
+fn clamp_scan<T: Level>(row: &mut [T], mask: &[T], direction: Direction, mut carry: T) -> T {
+    let mut step = |v: &mut T, m: T| {
+        *v = lower(*v, higher(m, carry));
         carry = *v;
     };
     match direction {
@@ -246,21 +371,22 @@ fn clamp_scan(row: &mut [f32], mask: &[f32], direction: Direction, mut carry: f3
     }
     carry
 }
+
 /// Pushes onto `queue` (as `offset + x`) each pixel of the finished anti-raster `row` with a
 /// neighbour after it — right in `row`, or in `next` (the row below and its mask) — that is
 /// above it and above its own mask: such a neighbour may still be lowered from it. Interior
 /// pixels are tested 32 at a time, branch-free, into a bit mask.
 #[inline(always)]
-fn queue_row(
-    row: &[f32],
-    mask: &[f32],
-    next: Option<(&[f32], &[f32])>,
+fn queue_row<T: Level>(
+    row: &[T],
+    mask: &[T],
+    next: Option<(&[T], &[T])>,
     offset: usize,
     queue: &mut VecDeque<usize>,
 ) {
     const LANES: usize = 32;
     let n = row.len();
-    let lowerable = |v: f32, q: f32, qm: f32| (q > v) & (q > qm);
+    let lowerable = |v: T, q: T, qm: T| (q > v) & (q > qm);
     let test = |x: usize| {
         let v = row[x];
         let mut push = x + 1 < n && lowerable(v, row[x + 1], mask[x + 1]);
@@ -276,7 +402,7 @@ fn queue_row(
         let lanes = LANES.min(n - x);
         let mut bits = 0u64;
         if lanes == LANES && x > 0 && x + LANES < n {
-            let at = |s: &[f32], start: usize| -> [f32; LANES] {
+            let at = |s: &[T], start: usize| -> [T; LANES] {
                 s[start..start + LANES].try_into().unwrap()
             };
             let (v, right, right_mask) = (at(row, x), at(row, x + 1), at(mask, x + 1));
@@ -305,115 +431,168 @@ fn queue_row(
     }
 }
 
-/// The AVX-512 clamp scan.
+/// The AVX-512 clamp scans, `f32` (16 lanes, AVX-512F) and `u16` (32 lanes, AVX-512BW), from
+/// one template.
 #[cfg(target_arch = "x86_64")]
 mod simd {
-    use std::arch::x86_64::*;
-
-    use super::Direction;
-
-    /// Lanes per vector.
-    const LANES: usize = 16;
-
-    /// Lane `i` takes lane `i − K` (forward scans, `KC = 16 − K`) or `i + K` (backward), and
-    /// `fill` where there is none.
-    macro_rules! shift {
-        ($forward:expr, $v:expr, $fill:expr, $k:literal, $kc:literal) => {{
-            let (v, fill) = (_mm512_castps_si512($v), _mm512_castps_si512($fill));
-            _mm512_castsi512_ps(if $forward {
-                _mm512_alignr_epi32::<$kc>(v, fill)
-            } else {
-                _mm512_alignr_epi32::<$k>(fill, v)
-            })
-        }};
-    }
-
-    /// Composes each lane's clamp `[lo, hi]` with the one before it in scan order
-    /// (`[slo, shi]`, applied first): the bounds of the earlier one, clamped by this one.
-    #[target_feature(enable = "avx512f")]
-    fn compose(lo: __m512, hi: __m512, slo: __m512, shi: __m512) -> (__m512, __m512) {
-        (
-            _mm512_min_ps(_mm512_max_ps(slo, lo), hi),
-            _mm512_min_ps(_mm512_max_ps(shi, lo), hi),
-        )
-    }
-
-    /// 16 pixels from `start`: a parallel prefix (Hillis–Steele) of the clamps, then the
-    /// clamp of the carry; returns the new carry (the last pixel in scan order, broadcast).
-    #[target_feature(enable = "avx512f")]
-    fn chunk<const FORWARD: bool>(
-        row: &mut [f32],
-        mask: &[f32],
-        start: usize,
-        carry: __m512,
-    ) -> __m512 {
-        let (neg, pos) = (
-            _mm512_set1_ps(f32::NEG_INFINITY),
-            _mm512_set1_ps(f32::INFINITY),
-        );
-        let (row, mask) = (&mut row[start..start + LANES], &mask[start..start + LANES]);
-        // SAFETY: both slices hold exactly 16 values.
-        let (mut lo, mut hi) = unsafe {
-            (
-                _mm512_loadu_ps(mask.as_ptr()),
-                _mm512_loadu_ps(row.as_ptr()),
-            )
-        };
-        (lo, hi) = compose(
-            lo,
-            hi,
-            shift!(FORWARD, lo, neg, 1, 15),
-            shift!(FORWARD, hi, pos, 1, 15),
-        );
-        (lo, hi) = compose(
-            lo,
-            hi,
-            shift!(FORWARD, lo, neg, 2, 14),
-            shift!(FORWARD, hi, pos, 2, 14),
-        );
-        (lo, hi) = compose(
-            lo,
-            hi,
-            shift!(FORWARD, lo, neg, 4, 12),
-            shift!(FORWARD, hi, pos, 4, 12),
-        );
-        (lo, hi) = compose(
-            lo,
-            hi,
-            shift!(FORWARD, lo, neg, 8, 8),
-            shift!(FORWARD, hi, pos, 8, 8),
-        );
-        let out = _mm512_min_ps(_mm512_max_ps(carry, lo), hi);
-        // SAFETY: `row` holds exactly 16 values.
-        unsafe { _mm512_storeu_ps(row.as_mut_ptr(), out) };
-        let last = if FORWARD { LANES as i32 - 1 } else { 0 };
-        _mm512_permutexvar_ps(_mm512_set1_epi32(last), out)
-    }
-
-    /// [`super::clamp_scan`] 16 pixels at a time; the same `min`/`max` results.
-    #[target_feature(enable = "avx512f")]
-    pub(super) fn clamp_scan(row: &mut [f32], mask: &[f32], direction: Direction) {
-        let n = row.len();
-        let full = n / LANES * LANES;
-        match direction {
-            Direction::Forward => {
-                let mut carry = _mm512_set1_ps(f32::INFINITY);
-                for start in (0..full).step_by(LANES) {
-                    carry = chunk::<true>(row, mask, start, carry);
-                }
-                let carry = _mm512_cvtss_f32(carry);
-                super::clamp_scan(&mut row[full..], &mask[full..n], direction, carry);
-            }
-            Direction::Backward => {
-                let tail = &mut row[full..];
-                let carry = super::clamp_scan(tail, &mask[full..n], direction, f32::INFINITY);
-                let mut carry = _mm512_set1_ps(carry);
-                for start in (0..full).step_by(LANES).rev() {
-                    carry = chunk::<false>(row, mask, start, carry);
-                }
-            }
+    /// The permutation index that moves lane `i − k` (forward) or `i + k` (backward) to lane
+    /// `i`, or takes lane `i` of the second source (the fill) where there is none.
+    const fn shift_index<const LANES: usize>(k: usize, forward: bool) -> [u16; LANES] {
+        let mut index = [0u16; LANES];
+        let mut i = 0;
+        while i < LANES {
+            let inside = if forward { i >= k } else { i + k < LANES };
+            index[i] = match (inside, forward) {
+                (true, true) => (i - k) as u16,
+                (true, false) => (i + k) as u16,
+                (false, _) => (LANES + i) as u16,
+            };
+            i += 1;
         }
+        index
     }
+
+    macro_rules! clamp_scan_simd {
+        ($module:ident, $features:literal, $t:ty, $lanes:literal, $steps:literal, $vector:ty,
+         $lowest:expr, $highest:expr, $elem:ty, $set1:ident, $load:ident, $store:ident,
+         $min:ident, $max:ident, $index_elem:ty, $index_load:ident, $permute2:ident,
+         $permute:ident, $first:ident) => {
+            /// The clamp scan on `$t`.
+            pub(super) mod $module {
+                use std::arch::x86_64::*;
+
+                use super::super::Direction;
+                use super::shift_index;
+
+                /// The permutation indices of the shifts by 1, 2, 4, … lanes and of the broadcast
+                /// of the last lane in scan order.
+                #[target_feature(enable = $features)]
+                fn indices(forward: bool) -> ([__m512i; $steps], __m512i) {
+                    let load = |index: [u16; $lanes]| {
+                        let index: [$index_elem; $lanes] = index.map(|i| i as $index_elem);
+                        // SAFETY: `index` holds one vector.
+                        unsafe { $index_load(index.as_ptr()) }
+                    };
+                    let shifts =
+                        std::array::from_fn(|s| load(shift_index::<$lanes>(1 << s, forward)));
+                    let last = if forward { $lanes - 1 } else { 0 };
+                    (shifts, load([last; $lanes]))
+                }
+
+                /// `$lanes` pixels from `start`: a parallel prefix (Hillis–Steele) of their clamps
+                /// `[mask, row]`, then the clamp of the carry; returns the new carry (the last
+                /// pixel in scan order, broadcast).
+                #[target_feature(enable = $features)]
+                fn chunk(
+                    row: &mut [$t],
+                    mask: &[$t],
+                    start: usize,
+                    carry: $vector,
+                    (shifts, last): &([__m512i; $steps], __m512i),
+                ) -> $vector {
+                    let (row, mask) = (
+                        &mut row[start..start + $lanes],
+                        &mask[start..start + $lanes],
+                    );
+                    let (low, high) = ($set1($lowest as $elem), $set1($highest as $elem));
+                    // SAFETY: both slices hold exactly one vector.
+                    let (mut lo, mut hi) = unsafe {
+                        (
+                            $load(mask.as_ptr() as *const $elem),
+                            $load(row.as_ptr() as *const $elem),
+                        )
+                    };
+                    for &shift in shifts {
+                        let (slo, shi) = ($permute2(lo, shift, low), $permute2(hi, shift, high));
+                        // The earlier clamp `[slo, shi]` then this one: its bounds, clamped.
+                        (lo, hi) = ($min($max(slo, lo), hi), $min($max(shi, lo), hi));
+                    }
+                    let out = $min($max(carry, lo), hi);
+                    // SAFETY: `row` holds exactly one vector.
+                    unsafe { $store(row.as_mut_ptr() as *mut $elem, out) };
+                    $permute(*last, out)
+                }
+
+                /// [`super::clamp_scan`] `$lanes` pixels at a time; the same `min`/`max` results.
+                #[target_feature(enable = $features)]
+                pub(in crate::reconstruct) fn clamp_scan(
+                    row: &mut [$t],
+                    mask: &[$t],
+                    direction: Direction,
+                ) {
+                    let forward = direction == Direction::Forward;
+                    let indices = indices(forward);
+                    let n = row.len();
+                    let full = n / $lanes * $lanes;
+                    if forward {
+                        let mut carry = $set1($highest as $elem);
+                        for start in (0..full).step_by($lanes) {
+                            carry = chunk(row, mask, start, carry, &indices);
+                        }
+                        let carry = $first(carry) as $t;
+                        super::super::clamp_scan(
+                            &mut row[full..],
+                            &mask[full..n],
+                            direction,
+                            carry,
+                        );
+                    } else {
+                        let tail = &mut row[full..];
+                        let carry =
+                            super::super::clamp_scan(tail, &mask[full..n], direction, $highest);
+                        let mut carry = $set1(carry as $elem);
+                        for start in (0..full).step_by($lanes).rev() {
+                            carry = chunk(row, mask, start, carry, &indices);
+                        }
+                    }
+                }
+            }
+        };
+    }
+
+    clamp_scan_simd!(
+        f32x16,
+        "avx512f",
+        f32,
+        16,
+        4,
+        __m512,
+        f32::NEG_INFINITY,
+        f32::INFINITY,
+        f32,
+        _mm512_set1_ps,
+        _mm512_loadu_ps,
+        _mm512_storeu_ps,
+        _mm512_min_ps,
+        _mm512_max_ps,
+        i32,
+        _mm512_loadu_epi32,
+        _mm512_permutex2var_ps,
+        _mm512_permutexvar_ps,
+        _mm512_cvtss_f32
+    );
+
+    clamp_scan_simd!(
+        u16x32,
+        "avx512f,avx512bw",
+        u16,
+        32,
+        5,
+        __m512i,
+        u16::MIN,
+        u16::MAX,
+        i16,
+        _mm512_set1_epi16,
+        _mm512_loadu_epi16,
+        _mm512_storeu_epi16,
+        _mm512_min_epu16,
+        _mm512_max_epu16,
+        i16,
+        _mm512_loadu_epi16,
+        _mm512_permutex2var_epi16,
+        _mm512_permutexvar_epi16,
+        _mm512_cvtsi512_si32
+    );
 }
 
 #[cfg(test)]
@@ -421,9 +600,9 @@ mod tests {
     use super::*;
 
     /// Every path of the row scan gives the scalar scan's values, in both directions, on rows
-    /// with full 16-lane chunks and tails.
+    /// with full SIMD chunks and tails, for `f32` values and `u16` levels.
     #[test]
-    fn simd_clamp_scan_matches_the_scalar_one() {
+    fn simd_clamp_scans_match_the_scalar_one() {
         let mut state = 7u64;
         let mut next = || {
             state = state
@@ -431,21 +610,35 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
-        for n in [1, 15, 16, 17, 64, 100] {
+        for n in [1, 15, 16, 17, 31, 32, 33, 64, 100] {
             let mask: Vec<f32> = (0..n).map(|_| next() * 0.5).collect();
             let hi: Vec<f32> = mask.iter().map(|&m| m + next() * 0.5).collect();
+            let levels =
+                |v: &[f32]| -> Vec<u16> { v.iter().map(|&x| (x * 600.0) as u16).collect() };
+            let (mask_levels, hi_levels) = (levels(&mask), levels(&hi));
             for direction in [Direction::Forward, Direction::Backward] {
                 let mut expected = hi.clone();
                 clamp_scan(&mut expected, &mask, direction, f32::INFINITY);
                 let mut got = hi.clone();
-                scan_row::<false>(&mut got, None, &mask, direction);
+                scan_row::<f32, false>(&mut got, None, &mask, direction);
                 assert_eq!(got, expected);
+                let mut expected_levels = hi_levels.clone();
+                clamp_scan(&mut expected_levels, &mask_levels, direction, u16::MAX);
                 #[cfg(target_arch = "x86_64")]
                 if std::is_x86_feature_detected!("avx512f") {
                     let mut simd = hi.clone();
                     // SAFETY: AVX-512F is available, checked just above.
-                    unsafe { simd::clamp_scan(&mut simd, &mask, direction) };
+                    unsafe { simd::f32x16::clamp_scan(&mut simd, &mask, direction) };
                     assert_eq!(simd, expected, "n = {n}, {direction:?}");
+                }
+                #[cfg(target_arch = "x86_64")]
+                if std::is_x86_feature_detected!("avx512f")
+                    && std::is_x86_feature_detected!("avx512bw")
+                {
+                    let mut simd = hi_levels.clone();
+                    // SAFETY: AVX-512F and AVX-512BW are available, checked just above.
+                    unsafe { simd::u16x32::clamp_scan(&mut simd, &mask_levels, direction) };
+                    assert_eq!(simd, expected_levels, "n = {n}, {direction:?}");
                 }
             }
         }

@@ -3,7 +3,7 @@
 mod common;
 
 use common::random_image;
-use sillage_core::GrayImage;
+use sillage_core::{GrayImage, Image};
 use sillage_image::Reconstruction;
 
 /// Reconstruction by erosion the obvious way: `R ← max(mask, min over the 3×3 window of R)`
@@ -97,6 +97,44 @@ fn h_concave_is_basin_depth_clipped_at_h() {
     engine.h_concave(&pit, h, &mut got).unwrap();
     assert!((got.get(4, 4) - h).abs() < 1e-6);
     assert!(got.get(0, 0).abs() < 1e-6);
+}
+
+/// The levels path gives exactly the levels of the reference on the levels as `f32` integers
+/// (exact arithmetic there), including markers above 255 (`f + h` for bright `f`; the landscape saturates at 255), on sizes
+/// with and without full SIMD chunks.
+#[test]
+fn h_concave_levels_is_exact() {
+    let mut engine = Reconstruction::new();
+    for (seed, (w, h)) in [(1, 1), (31, 1), (1, 9), (50, 40), (97, 33), (150, 20)]
+        .into_iter()
+        .enumerate()
+    {
+        let src = landscape(w, h, seed as u64 + 10);
+        let data = src.as_slice().iter().map(|&v| (v * 255.0).round().min(255.0) as u8);
+        let levels = Image::from_vec(w, h, data.collect()).unwrap();
+        for height in [1u8, 44, 200] {
+            let as_f32 = |image: &Image<u8>| {
+                let data = image.as_slice().iter().map(|&k| f32::from(k)).collect();
+                GrayImage::from_vec(w, h, data).unwrap()
+            };
+            let mask = as_f32(&levels);
+            let mut marker = mask.clone();
+            marker
+                .as_mut_slice()
+                .iter_mut()
+                .for_each(|v| *v += f32::from(height));
+            let filled = reference(&marker, &mask);
+            let mut got = Image::default();
+            engine.h_concave_levels(&levels, height, &mut got);
+            let expected: Vec<f32> = filled
+                .as_slice()
+                .iter()
+                .zip(mask.as_slice())
+                .map(|(r, f)| r - f)
+                .collect();
+            assert_eq!(as_f32(&got).as_slice(), expected, "{w}×{h}, h = {height}");
+        }
+    }
 }
 
 #[test]

@@ -53,7 +53,7 @@ mod params;
 mod transparent;
 
 use sillage_core::{Detection, Detector, Error, GrayImage, Image, Result};
-use sillage_image::RingTemplate;
+use sillage_image::{RingTemplate, encode_levels};
 
 pub use params::{BeadGeometry, BeadParams};
 
@@ -90,6 +90,10 @@ pub struct BeadDetector {
     geometry: BeadGeometry,
     base: Option<Image<bool>>,
     bright_base: GrayImage,
+    /// h as an 8-bit level, when it is one (`None`: frames take the `f32` path).
+    h_level: Option<u8>,
+    /// The 8-bit levels of the bright-base frame (the fast path).
+    levels: Image<u8>,
     black: BlackStage,
     transparent: TransparentStage,
     beads: BeadDetections,
@@ -122,10 +126,12 @@ impl BeadDetector {
                 (params.black_min_area_ratio, params.black_max_area_ratio),
             )?,
             transparent: TransparentStage::new(settings, template)?,
+            h_level: level_of(settings.h),
             params,
             geometry,
             base: None,
             bright_base: GrayImage::default(),
+            levels: Image::default(),
             beads: BeadDetections::default(),
         })
     }
@@ -177,6 +183,29 @@ impl BeadDetector {
                 base.height()
             )));
         }
+        if let Some(h) = self.h_level
+            && encode_levels(frame, &mut self.levels)
+        {
+            // 8-bit frames: every stage on the levels, from this one encoding.
+            if let Some(base) = &self.base {
+                for (v, &b) in self.levels.as_mut_slice().iter_mut().zip(base.as_slice()) {
+                    *v |= u8::from(b).wrapping_neg();
+                }
+            }
+            self.black.detect_levels(&self.levels, &mut out.black);
+            self.transparent.detect_levels(
+                frame,
+                &self.levels,
+                h,
+                self.base.as_ref(),
+                &out.black,
+                TransparentOutput {
+                    beads: &mut out.transparent,
+                    candidates: &mut out.candidates,
+                },
+            );
+            return Ok(());
+        }
         match &self.base {
             Some(base) => {
                 self.bright_base.reshape(frame.width(), frame.height());
@@ -208,6 +237,11 @@ impl BeadDetector {
     }
 }
 
+/// The 8-bit level `k` with `k / 255 = value` in `f32` (as frames decode), if there is one.
+fn level_of(value: f32) -> Option<u8> {
+    (0..=u8::MAX).find(|&k| f32::from(k) / 255.0 == value)
+}
+
 /// All beads as plain detections, black ones first (strength 1) then transparent ones
 /// (strength = correlation), for consumers that need positions only (PTV, detection scores,
 /// overlays). The bead category and the confidence candidates, which the MMPF+ tracker
@@ -221,5 +255,51 @@ impl Detector for BeadDetector {
         out.extend_from_slice(&beads.transparent);
         self.beads = beads;
         result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use sillage_io::read_image;
+
+    use super::*;
+
+    /// A real 8-bit frame of the shared sequence with its base mask takes the levels path; the
+    /// `f32` path (forced) finds the same black beads exactly and the same transparent beads
+    /// and candidates, with correlations within the `f32` path's rounding.
+    #[test]
+    fn levels_path_finds_what_the_f32_path_finds() {
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
+        let frame = read_image(format!(
+            "{root}/bedload_beads_lafaye2018/images/BaumerBim10MegaAmont0507Image72040.tif"
+        ))
+        .unwrap();
+        let mask = read_image(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/sequence_base_mask.png"
+        ))
+        .unwrap();
+        let params = BeadParams {
+            candidate_threshold: 0.1,
+            ..BeadParams::default()
+        };
+        let mut detector = BeadDetector::new(params).unwrap().with_base_mask(&mask);
+        assert_eq!(detector.h_level, Some(44));
+        let (mut levels, mut general) = (BeadDetections::default(), BeadDetections::default());
+        detector.detect_beads(&frame, &mut levels).unwrap();
+        detector.h_level = None;
+        detector.detect_beads(&frame, &mut general).unwrap();
+        assert!(levels.black.len() > 300 && levels.candidates.len() > 400);
+        assert_eq!(levels.black, general.black);
+        for (fast, slow) in [
+            (&levels.transparent, &general.transparent),
+            (&levels.candidates, &general.candidates),
+        ] {
+            assert_eq!(fast.len(), slow.len());
+            for (a, b) in fast.iter().zip(slow) {
+                assert_eq!(a.pos_px, b.pos_px);
+                assert!((a.strength - b.strength).abs() < 1e-4, "{a:?} {b:?}");
+            }
+        }
     }
 }

@@ -41,6 +41,10 @@ pub(crate) struct TransparentStage {
     correlation: GrayImage,
     smoothed: GrayImage,
     peaks: Vec<Peak>,
+    /// The levels path's closing, top-hat and h-concave transform.
+    closed_levels: Image<u8>,
+    top_hat_levels: Image<u8>,
+    concave_levels: Image<u8>,
 }
 
 /// What one frame gives: transparent beads and confidence candidates.
@@ -66,6 +70,9 @@ impl TransparentStage {
             correlation: GrayImage::default(),
             smoothed: GrayImage::default(),
             peaks: Vec::new(),
+            closed_levels: Image::default(),
+            top_hat_levels: Image::default(),
+            concave_levels: Image::default(),
         })
     }
 
@@ -85,13 +92,62 @@ impl TransparentStage {
         black: &[Detection],
         out: TransparentOutput<'_>,
     ) -> Result<()> {
-        let s = self.settings;
         self.morphology
             .close(bright_base, &self.background, &mut self.closed);
-        self.erased_top_hat(frame, base, black);
+        erased_top_hat(
+            &self.closed,
+            frame,
+            base,
+            black,
+            &self.erase_runs,
+            &mut self.top_hat,
+        );
         self.reconstruction
-            .h_concave(&self.top_hat, s.h, &mut self.concave)?;
+            .h_concave(&self.top_hat, self.settings.h, &mut self.concave)?;
         self.correlator.apply(&self.concave, &mut self.correlation);
+        self.select(frame, base, out);
+        Ok(())
+    }
+
+    /// [`TransparentStage::detect`] on the 8-bit levels of the bright-base frame, with `h`
+    /// as a level: closing, top-hat and h-concave transform exactly on levels, the
+    /// correlation with exact integer sums (the `f32` path rounds `closing − f`, `+ h` and
+    /// its correlation sums, within `f32` rounding of these values).
+    pub(crate) fn detect_levels(
+        &mut self,
+        frame: &GrayImage,
+        bright_base: &Image<u8>,
+        h: u8,
+        base: Option<&Image<bool>>,
+        black: &[Detection],
+        out: TransparentOutput<'_>,
+    ) {
+        self.morphology
+            .close_levels(bright_base, &self.background, &mut self.closed_levels);
+        erased_top_hat(
+            &self.closed_levels,
+            bright_base,
+            base,
+            black,
+            &self.erase_runs,
+            &mut self.top_hat_levels,
+        );
+        self.reconstruction
+            .h_concave_levels(&self.top_hat_levels, h, &mut self.concave_levels);
+        self.correlator
+            .apply_levels(&self.concave_levels, &mut self.correlation);
+        self.select(frame, base, out);
+    }
+
+    /// Smooths the correlation map and appends its maxima off the base and not too dark in
+    /// `frame`: candidates, and beads where they reach τ_t.
+    fn select(
+        &mut self,
+        frame: &GrayImage,
+        base: Option<&Image<bool>>,
+        out: TransparentOutput<'_>,
+    ) {
+        let s = self.settings;
         for _ in 0..s.smoothing_passes {
             box_mean_3x3(&self.correlation, &mut self.smoothed);
             std::mem::swap(&mut self.correlation, &mut self.smoothed);
@@ -116,52 +172,71 @@ impl TransparentStage {
                 out.beads.push(candidate);
             }
         }
-        Ok(())
     }
+}
 
-    /// `top_hat = closed − frame` (the black top-hat: dark rings stand out), 0 on the base and
-    /// on a disk around each black bead: there the frame is replaced by the background, as
-    /// the paper erases black beads before looking for transparent ones.
-    fn erased_top_hat(
-        &mut self,
-        frame: &GrayImage,
-        base: Option<&Image<bool>>,
-        black: &[Detection],
-    ) {
-        let (width, height) = frame.dimensions();
-        self.top_hat.reshape(width, height);
-        let pixels = self
-            .top_hat
-            .as_mut_slice()
-            .iter_mut()
-            .zip(self.closed.as_slice())
-            .zip(frame.as_slice());
-        match base {
-            Some(base) => {
-                // Branch-free (`c − f` with its bits cleared on the base), so that it
-                // vectorises.
-                for (((t, &c), &f), &b) in pixels.zip(base.as_slice()) {
-                    let keep = u32::from(b).wrapping_sub(1);
-                    *t = f32::from_bits((c - f).to_bits() & keep);
-                }
+/// A pixel type of the top-hat: `f32` grey levels or 8-bit levels.
+trait TopHatPixel: Copy + Default + Send + Sync {
+    /// `closed − frame` (never negative: a closing is above its image), 0 on the base.
+    fn top_hat(closed: Self, frame: Self, on_base: bool) -> Self;
+}
+
+impl TopHatPixel for f32 {
+    #[inline(always)]
+    fn top_hat(closed: f32, frame: f32, on_base: bool) -> f32 {
+        // Branch-free (`c − f` with its bits cleared on the base), so that it vectorises.
+        let keep = u32::from(on_base).wrapping_sub(1);
+        f32::from_bits((closed - frame).to_bits() & keep)
+    }
+}
+
+impl TopHatPixel for u8 {
+    #[inline(always)]
+    fn top_hat(closed: u8, frame: u8, on_base: bool) -> u8 {
+        closed.wrapping_sub(frame) & u8::from(on_base).wrapping_sub(1)
+    }
+}
+
+/// `top_hat` (reshaped) `= closed − frame` (the black top-hat: dark rings stand out), 0 on
+/// the base and on the disk `erase_runs` around each black bead: there the frame is replaced
+/// by the background, as the paper erases black beads before looking for transparent ones.
+fn erased_top_hat<T: TopHatPixel>(
+    closed: &Image<T>,
+    frame: &Image<T>,
+    base: Option<&Image<bool>>,
+    black: &[Detection],
+    erase_runs: &[(isize, isize, isize)],
+    top_hat: &mut Image<T>,
+) {
+    let (width, height) = frame.dimensions();
+    top_hat.reshape(width, height);
+    let pixels = top_hat
+        .as_mut_slice()
+        .iter_mut()
+        .zip(closed.as_slice())
+        .zip(frame.as_slice());
+    match base {
+        Some(base) => {
+            for (((t, &c), &f), &b) in pixels.zip(base.as_slice()) {
+                *t = T::top_hat(c, f, b);
             }
-            None => pixels.for_each(|((t, &c), &f)| *t = c - f),
         }
-        for bead in black {
-            let (cx, cy) = (
-                bead.pos_px.x.round() as isize,
-                bead.pos_px.y.round() as isize,
-            );
-            for &(dy, dx0, dx1) in &self.erase_runs {
-                let y = cy + dy;
-                if y < 0 || y >= height as isize {
-                    continue;
-                }
-                let x0 = (cx + dx0).max(0);
-                let x1 = (cx + dx1).min(width as isize - 1);
-                if x0 <= x1 {
-                    self.top_hat.row_mut(y as usize)[x0 as usize..=x1 as usize].fill(0.0);
-                }
+        None => pixels.for_each(|((t, &c), &f)| *t = T::top_hat(c, f, false)),
+    }
+    for bead in black {
+        let (cx, cy) = (
+            bead.pos_px.x.round() as isize,
+            bead.pos_px.y.round() as isize,
+        );
+        for &(dy, dx0, dx1) in erase_runs {
+            let y = cy + dy;
+            if y < 0 || y >= height as isize {
+                continue;
+            }
+            let x0 = (cx + dx0).max(0);
+            let x1 = (cx + dx1).min(width as isize - 1);
+            if x0 <= x1 {
+                top_hat.row_mut(y as usize)[x0 as usize..=x1 as usize].fill(T::default());
             }
         }
     }

@@ -18,6 +18,14 @@
 //!   0, but the prefixes stay small: two reads per vertical run of ring pixels (36 runs for
 //!   BeadTracking's 21×21 template) instead of 204 reads, accumulated in registers over
 //!   chunks of 64 pixels. [`RingCorrelator::apply`] states the resulting error bound.
+//!
+//! 8-bit levels: [`RingCorrelator::apply_levels`] computes every sum exactly in integers (the
+//! ring sums in wrapping 16-bit lanes), see `levels.rs`.
+
+mod levels;
+
+use std::num::Wrapping;
+use std::ops::{Add, Mul, Sub};
 
 use rayon::prelude::*;
 use sillage_core::{Error, GrayImage, Result};
@@ -229,6 +237,9 @@ pub struct RingCorrelator {
     /// (`(BAND_ROWS + 2R + 1) × (width + 2R)`), one difference of two prefix rows
     /// (`width + 2R`) and the ring sums of one row (`width`).
     band_f32: Vec<f32>,
+    /// The levels path's per-band buffers (see [`RingCorrelator::apply_levels`]).
+    band_i32: Vec<i32>,
+    band_u16: Vec<Wrapping<u16>>,
     /// See [`BandInput::reads`].
     reads: Vec<(usize, usize)>,
 }
@@ -240,6 +251,8 @@ impl RingCorrelator {
             template,
             band_f64: Vec::new(),
             band_f32: Vec::new(),
+            band_i32: Vec::new(),
+            band_u16: Vec::new(),
             reads: Vec::new(),
         }
     }
@@ -280,17 +293,7 @@ impl RingCorrelator {
         // Centring the ring sums on the image mean keeps their f32 prefixes small; the
         // numerator is invariant to it (the zero-mean template sums to 0 over the window).
         let mean = lane_sum(src.as_slice()) / (width * height) as f64;
-        // Run rows y + dy0 ..= y + dy1 of output row y = y0 + j are the prefix rows
-        // j + r + dy0 .. j + r + dy1 + 1 of its band; its column x + dx is padded column
-        // x + r + dx.
-        self.reads.clear();
-        for &((dy0, dy1), ref columns) in &self.template.runs {
-            for &dx in columns {
-                let at = |k: isize| (k as usize) * padded_w + (r as isize + dx) as usize;
-                self.reads
-                    .push((at(r as isize + dy0), at(r as isize + dy1 + 1)));
-            }
-        }
+        self.set_reads(padded_w);
         let input = BandInput {
             template: &self.template,
             reads: &self.reads,
@@ -308,14 +311,36 @@ impl RingCorrelator {
     }
 }
 
+impl RingCorrelator {
+    /// Sets [`BandInput::reads`] for band buffers `padded_w` wide: run rows `y + dy0 ..= y +
+    /// dy1` of output row `y = y0 + j` are the prefix rows `j + r + dy0 .. j + r + dy1 + 1`
+    /// of its band; its column `x + dx` is padded column `x + r + dx`.
+    fn set_reads(&mut self, padded_w: usize) {
+        let r = self.template.radius as isize;
+        self.reads.clear();
+        for &((dy0, dy1), ref columns) in &self.template.runs {
+            for &dx in columns {
+                let at = |k: isize| (k as usize) * padded_w + (r + dx) as usize;
+                self.reads.push((at(r + dy0), at(r + dy1 + 1)));
+            }
+        }
+    }
+}
+
 /// `out[x] = Σ values[x..x + window]` for each `x` of `out`, by binary decomposition of
 /// `window`: sums of blocks of 2, 4, 8, … values are doubled from one scratch buffer into the
 /// other (`a`, `b`, as long as `values`) and the blocks of the set bits added: `O(log window)`
 /// vectorised passes instead of `window`.
 #[inline(always)]
-fn sliding_sum(values: &[f64], a: &mut [f64], b: &mut [f64], window: usize, out: &mut [f64]) {
+fn sliding_sum<T: Copy + Add<Output = T>>(
+    values: &[T],
+    a: &mut [T],
+    b: &mut [T],
+    window: usize,
+    out: &mut [T],
+) {
     let n = out.len();
-    let (mut current, mut spare): (&mut [f64], &mut [f64]) = (a, b);
+    let (mut current, mut spare): (&mut [T], &mut [T]) = (a, b);
     let (mut block, mut offset, mut bits, mut first) = (1, 0, window, true);
     loop {
         if bits & 1 == 1 {
@@ -326,7 +351,7 @@ fn sliding_sum(values: &[f64], a: &mut [f64], b: &mut [f64], window: usize, out:
                 first = false;
             } else {
                 for (o, &v) in out.iter_mut().zip(blocks) {
-                    *o += v;
+                    *o = *o + v;
                 }
             }
             offset += block;
@@ -408,34 +433,37 @@ fn correlate_band_avx512(
     correlate_band(input, y0, out, s64, s32);
 }
 
-/// `col += enter − leave` and `col_sq += enter² − leave²` in `f64`, for the rows present.
+/// `col += enter − leave` and `col_sq += enter² − leave²` in `S` (`f64` for `f32` pixels,
+/// `i32` for 8-bit levels), for the rows present.
 #[inline(always)]
-fn update_columns(
-    col: &mut [f64],
-    col_sq: &mut [f64],
-    enter: Option<&[f32]>,
-    leave: Option<&[f32]>,
-) {
+fn update_columns<P: Copy, S>(
+    col: &mut [S],
+    col_sq: &mut [S],
+    enter: Option<&[P]>,
+    leave: Option<&[P]>,
+) where
+    S: Copy + From<P> + Add<Output = S> + Sub<Output = S> + Mul<Output = S>,
+{
     match (enter, leave) {
         (Some(enter), Some(leave)) => {
             for (((c, q), &a), &b) in col.iter_mut().zip(col_sq.iter_mut()).zip(enter).zip(leave) {
-                let (a, b) = (f64::from(a), f64::from(b));
-                *c += a - b;
-                *q += a * a - b * b;
+                let (a, b) = (S::from(a), S::from(b));
+                *c = *c + (a - b);
+                *q = *q + (a * a - b * b);
             }
         }
         (Some(enter), None) => {
             for ((c, q), &a) in col.iter_mut().zip(col_sq.iter_mut()).zip(enter) {
-                let a = f64::from(a);
-                *c += a;
-                *q += a * a;
+                let a = S::from(a);
+                *c = *c + a;
+                *q = *q + a * a;
             }
         }
         (None, Some(leave)) => {
             for ((c, q), &b) in col.iter_mut().zip(col_sq.iter_mut()).zip(leave) {
-                let b = f64::from(b);
-                *c -= b;
-                *q -= b * b;
+                let b = S::from(b);
+                *c = *c - b;
+                *q = *q - b * b;
             }
         }
         (None, None) => {}
@@ -446,25 +474,28 @@ fn update_columns(
 const RING_CHUNK: usize = 64;
 
 /// `ring[x] = Σ over reads (lo, hi) of prefix[hi + x] − prefix[lo + x]`, the reads in their
-/// order for every pixel; chunks of [`RING_CHUNK`] pixels keep their sums in registers
-/// across all the reads.
+/// order for every pixel, from 0 (`T::default()`); chunks of [`RING_CHUNK`] pixels keep their
+/// sums in registers across all the reads.
 #[inline(always)]
-fn ring_sums(prefix: &[f32], reads: &[(usize, usize)], ring: &mut [f32]) {
+fn ring_sums<T>(prefix: &[T], reads: &[(usize, usize)], ring: &mut [T])
+where
+    T: Copy + Default + Add<Output = T> + Sub<Output = T>,
+{
     let n = ring.len();
     let full = n / RING_CHUNK * RING_CHUNK;
     for x in (0..full).step_by(RING_CHUNK) {
-        let mut acc = [0.0f32; RING_CHUNK];
+        let mut acc = [T::default(); RING_CHUNK];
         for &(lo, hi) in reads {
-            let high: &[f32; RING_CHUNK] = prefix[hi + x..][..RING_CHUNK].try_into().unwrap();
-            let low: &[f32; RING_CHUNK] = prefix[lo + x..][..RING_CHUNK].try_into().unwrap();
+            let high: &[T; RING_CHUNK] = prefix[hi + x..][..RING_CHUNK].try_into().unwrap();
+            let low: &[T; RING_CHUNK] = prefix[lo + x..][..RING_CHUNK].try_into().unwrap();
             for i in 0..RING_CHUNK {
-                acc[i] += high[i] - low[i];
+                acc[i] = acc[i] + (high[i] - low[i]);
             }
         }
         ring[x..x + RING_CHUNK].copy_from_slice(&acc);
     }
     for (x, out) in ring.iter_mut().enumerate().skip(full) {
-        *out = reads.iter().fold(0.0, |acc, &(lo, hi)| {
+        *out = reads.iter().fold(T::default(), |acc, &(lo, hi)| {
             acc + (prefix[hi + x] - prefix[lo + x])
         });
     }
@@ -595,7 +626,12 @@ mod tests {
 
     /// Direct NCC in `f64`, the template centred on each pixel, zeros outside the image;
     /// returns the value and the denominator `√(Σt'² · Σ(f − f̄)²)` (0 on flat windows).
-    fn direct(src: &GrayImage, template: &RingTemplate, x: usize, y: usize) -> (f64, f64) {
+    pub(super) fn direct(
+        src: &GrayImage,
+        template: &RingTemplate,
+        x: usize,
+        y: usize,
+    ) -> (f64, f64) {
         let r = template.radius as isize;
         let (w, h) = src.dimensions();
         let mut ring = vec![false; ((2 * r + 1) * (2 * r + 1)) as usize];
