@@ -12,7 +12,7 @@ const DATA: &str = concat!(
 );
 const MASK: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../sillage-detect/tests/data/sequence_base_mask.png"
+    "/../../../shared/data/bedload_beads_lafaye2018/sequence_base_mask.tif"
 );
 
 #[test]

@@ -25,7 +25,7 @@ fn bench_bead(c: &mut Criterion) {
     .unwrap();
     let mask = read_image(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/sequence_base_mask.png"
+        "/../../../shared/data/bedload_beads_lafaye2018/sequence_base_mask.tif"
     ))
     .unwrap();
     let mut group = c.benchmark_group("bead_1280x320");

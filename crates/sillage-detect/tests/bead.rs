@@ -2,9 +2,8 @@
 //! (`shared/data/bedload_beads_lafaye2018`) against their hand-edited ground truth, with the
 //! paper's acceptance targets, and bad input.
 //!
-//! The flume-base mask is `tests/data/sequence_base_mask.png`, the shared
-//! `sequence_base_mask.tif` converted to PNG (white = base): that TIFF is CCITT-RLE
-//! compressed, which `sillage_io::read_image` cannot decode yet.
+//! The flume-base mask is the authors' `sequence_base_mask.tif` (white = base), a CCITT
+//! modified-Huffman TIFF that `sillage_io::read_image` decodes.
 
 use sillage_core::{Detection, Detector, FrameIndex, GrayImage, TruthPoint};
 use sillage_detect::{BeadDetections, BeadDetector, BeadParams};
@@ -28,11 +27,7 @@ fn ring_template() -> GrayImage {
 }
 
 fn base_mask() -> GrayImage {
-    read_image(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/sequence_base_mask.png"
-    ))
-    .unwrap()
+    read_image(format!("{DATA}/sequence_base_mask.tif")).unwrap()
 }
 
 /// The ten frames, in order.

@@ -110,7 +110,10 @@ fn h_concave_levels_is_exact() {
         .enumerate()
     {
         let src = landscape(w, h, seed as u64 + 10);
-        let data = src.as_slice().iter().map(|&v| (v * 255.0).round().min(255.0) as u8);
+        let data = src
+            .as_slice()
+            .iter()
+            .map(|&v| (v * 255.0).round().min(255.0) as u8);
         let levels = Image::from_vec(w, h, data.collect()).unwrap();
         for height in [1u8, 44, 200] {
             let as_f32 = |image: &Image<u8>| {

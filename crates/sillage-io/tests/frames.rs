@@ -289,10 +289,10 @@ const CCITT_MASK: &str = concat!(
 #[test]
 fn ccitt_modified_huffman_tiff_matches_its_png_conversion() {
     let mask = read_image(CCITT_MASK).unwrap();
-    // The same mask converted to PNG by another decoder (Pillow, libtiff's).
+    // The same mask converted to PNG by another decoder.
     let png = read_image(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../sillage-detect/tests/data/sequence_base_mask.png"
+        "/tests/data/sequence_base_mask.png"
     ))
     .unwrap();
     assert_eq!((mask.width(), mask.height()), (1280, 320));

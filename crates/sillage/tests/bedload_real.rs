@@ -26,11 +26,7 @@ fn detections() -> Vec<BeadDetections> {
         transparent_diameter_m: sequence.transparent_diameter_m,
         ..BeadParams::default()
     };
-    let mask = read_image(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../sillage-detect/tests/data/sequence_base_mask.png"
-    ))
-    .unwrap();
+    let mask = read_image(format!("{DATA}/sequence_base_mask.tif")).unwrap();
     let template: GrayImage =
         read_matrix_csv(format!("{DATA}/template_transparent_bead_rOut10_rIn6.csv")).unwrap();
     let mut detector = BeadDetector::new(params)

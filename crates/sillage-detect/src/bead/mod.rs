@@ -274,9 +274,8 @@ mod tests {
             "{root}/bedload_beads_lafaye2018/images/BaumerBim10MegaAmont0507Image72040.tif"
         ))
         .unwrap();
-        let mask = read_image(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/tests/data/sequence_base_mask.png"
+        let mask = read_image(format!(
+            "{root}/bedload_beads_lafaye2018/sequence_base_mask.tif"
         ))
         .unwrap();
         let params = BeadParams {
