@@ -117,6 +117,9 @@ pub(crate) struct Mover {
     pub state: MotionState,
     /// Its speed along x while rolling, px/frame.
     rolling_speed: f64,
+    /// How far it fell in the last frame while in the air (not in a saltation), px: its
+    /// fall speed, which gravity raises in the next frame ([`super::pile::Pile`]).
+    pub fall_px: f64,
     flight: Flight,
 }
 
@@ -137,6 +140,7 @@ impl Mover {
             anchor: dynamics.on_surface(x, class),
             state,
             rolling_speed: uniform(rng, dynamics.params.rolling_speed_px_per_frame),
+            fall_px: 0.0,
             flight: Flight::default(),
         }
     }
@@ -164,8 +168,8 @@ impl Mover {
         }
     }
 
-    /// A resting bead whose support went away (it took off) falls onto what lies below: it
-    /// is set rolling, at the speed of its last roll.
+    /// A resting bead that the contacts moved (its support went away and it falls, or it
+    /// slides off a bead left steep) is set rolling, at the speed of its last roll.
     pub(crate) fn fall(&mut self) {
         if self.state == MotionState::Resting {
             self.state = MotionState::Rolling;
@@ -174,10 +178,11 @@ impl Mover {
 
     /// Enters state `next` and returns its move, which the pile then limits by the
     /// contacts: resting stays put, rolling advances by its speed along x (a `loaded` bead,
-    /// which another lies on, stays put), saltating follows its hop, planned over the pile's top `dynamics.top`
-    /// to land on it exactly on the saltation's last frame (or earlier on a bead that has
-    /// moved in the way, see [`Mover::end_flight_frame`]). A bead whose first hop would
-    /// move it by more than `MAX_STEP_PX` (out of a deep hole) does not take off.
+    /// which another lies on, stays put), saltating follows its hop, planned over the pile's
+    /// top `dynamics.top` to land on it exactly on the saltation's last frame (or earlier on
+    /// a bead that has moved in the way, see [`Mover::end_flight_frame`]). A bead whose
+    /// first hop would move it by more than `MAX_STEP_PX` (out of a deep hole), or which
+    /// another lies on, does not take off.
     pub(crate) fn step(
         &mut self,
         next: MotionState,
@@ -187,17 +192,19 @@ impl Mover {
     ) -> Proposal {
         let mut next = next;
         if next == MotionState::Saltating && self.state != MotionState::Saltating {
-            self.launch(dynamics, motion);
-            let to = self.fly(dynamics, motion);
-            if to.distance(self.anchor) <= MAX_STEP_PX {
-                self.state = next;
-                return Proposal::Air {
-                    to,
-                    lands: self.flight.frames_left == 0,
-                };
+            if !loaded {
+                self.launch(dynamics, motion);
+                let to = self.fly(dynamics, motion);
+                if to.distance(self.anchor) <= MAX_STEP_PX {
+                    self.state = next;
+                    return Proposal::Air {
+                        to,
+                        lands: self.flight.frames_left == 0,
+                    };
+                }
             }
-            // Too deep in a hole between higher beads to leave it but steeply: it stays in
-            // its state (a take-off is 1 % per frame in Eq. (11)).
+            // Held down by a bead on it, or too deep in a hole between higher beads to leave
+            // it but steeply: it stays in its state.
             next = self.state;
         }
         let proposal = match next {

@@ -342,7 +342,9 @@ impl BedloadScene {
             match *proposal {
                 Proposal::Air { .. } => mover.end_flight_frame(self.pile.stopped(i)),
                 // `pos` is still where it was seen in the last frame.
-                Proposal::Ground { .. } if mover.anchor.y > pos.y + half + 1e-9 => mover.fall(),
+                Proposal::Ground { .. } if mover.anchor.distance(*pos) > half + 1e-9 => {
+                    mover.fall()
+                }
                 _ => {}
             }
             // A resting bead is seen off its place by the jitter, kept in the frame by a
