@@ -91,8 +91,10 @@ impl BedloadFrame {
 /// [`BedloadSceneParams::contact_factors`]. Each frame, every mobile bead draws its state
 /// and its move, then takes its place among the others, bottom first: it lies on the upper
 /// envelope of the bed and of the beads below it, is held back where it would have to climb
-/// onto a bead not lower than itself (`min_climb_angle_deg`), drop off a ledge higher than
-/// its diameter or run into a bead above, and does not move while another bead lies on it.
+/// onto a bead not lower than itself (`min_climb_angle_deg`) or run into a bead above, and
+/// does not roll while another bead lies on it. Moves are continuous, at most 25 px a frame
+/// (below BeadTracking's 31 px search radius, MMPF+ §4.3): a bead that runs off a ledge or
+/// loses its support falls under `gravity_px_per_frame2` with a capped speed.
 ///
 /// The motion agrees with the state: a resting bead moves by at most `resting_jitter_px`;
 /// a rolling one advances downstream by at most its speed, on the bed or on beads (never
