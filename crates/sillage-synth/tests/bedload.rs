@@ -87,10 +87,10 @@ fn ids_are_unique_never_reused_and_the_counts_stay_constant() {
         gone.extend(previous.difference(&ids));
         previous = ids;
     }
-    // The contacts hold beads back: about 0.02 crossings per frame, below the real
-    // sequence's (1 entry and 1 exit in its 10 frames with truth; Σ|vx| / 1280 = 0.20 per
-    // frame): a known defect, the flux is too low.
-    assert!(births > 20, "only {births} beads crossed the frame");
+    // The creeping layers and the beads they carry cross the frame (the real sequence: 1
+    // entry and 1 exit in its 10 frames with truth; Σ|vx| / 1280 = 0.21 per frame).
+    println!("{births} beads crossed the frame in 1500 frames");
+    assert!(births > 40, "only {births} beads crossed the frame");
     assert_eq!(births, gone.len());
 }
 
@@ -138,6 +138,7 @@ fn motion_agrees_with_the_motion_state() {
         };
         let jitter = params.resting_jitter_px;
         let clearance = params.hop_clearance_px;
+        let hop_speed = params.saltation_speed_px_per_frame[0];
         let mut scene = BedloadScene::new(params).unwrap();
         let mut frames_seen = Vec::new();
         while let Some(frame) = scene.next_frame() {
@@ -174,7 +175,7 @@ fn motion_agrees_with_the_motion_state() {
                     assert!(bead.pos_px.y <= surface + 1e-9, "below the bed: {bead:?}");
                     // Downstream; at the hop's speed unless stopped against a bead.
                     assert!(v.x * f64::from(flow_direction) >= -1e-9, "{v:?}");
-                    if v.x * f64::from(flow_direction) >= 10.0 - jitter {
+                    if v.x * f64::from(flow_direction) >= hop_speed - jitter {
                         fast += 1;
                     }
                     if bead.pos_px.y <= surface - clearance + 1e-9 {
@@ -200,10 +201,10 @@ fn motion_agrees_with_the_motion_state() {
             "{backwards} of {rolling} backwards"
         );
         assert!(
-            advancing * 20 > rolling,
+            advancing * 10 > rolling,
             "{advancing} of {rolling} advancing"
         );
-        println!("{fast} of {saltating} saltating steps at 10 px/frame or more");
+        println!("{fast} of {saltating} saltating steps at {hop_speed} px/frame or more");
         assert!(fast * 10 > saltating * 8, "{fast} of {saltating} fast");
         // Most saltating frames are in the air, the others are contacts (take-off, rebound
         // or landing on the surface).
@@ -216,7 +217,16 @@ fn motion_agrees_with_the_motion_state() {
 
 #[test]
 fn state_transitions_follow_the_table() {
-    let params = frames(4000, 5);
+    // The table drives the mobile beads' own motion; a creeping layer carries the beads
+    // lying on it, which are then reported rolling whatever their state (the motion test
+    // checks that). The table's frequencies are measured without the carry: on a static bed
+    // of 6 layers, all black.
+    let params = BedloadSceneParams {
+        bed_layers: 6,
+        creeping_layers: 0,
+        transparent_in_bed: 0.0,
+        ..frames(4000, 5)
+    };
     let table = params.transition_probabilities;
     let mut counts = [[0usize; 3]; 3];
     let mut previous: HashMap<TrackId, MotionState> = HashMap::new();
@@ -281,13 +291,34 @@ fn bed_beads_touch_their_neighbours() {
         }
         contacts.push(n);
     }
-    let many = contacts.iter().filter(|&&n| n >= 5).count();
-    assert!(
-        many * 2 > bed.len(),
-        "{many} of {} bed beads with ≥ 5 contacts",
-        bed.len()
+    // The black lattice: most of its beads touch 5 or more (a transparent bead lodged in a
+    // site touches the two below it; the real frames: 62 % of the resting black beads).
+    let black: Vec<usize> = contacts
+        .iter()
+        .zip(&bed)
+        .filter(|(_, b)| b.class == BLACK_BEAD_CLASS)
+        .map(|(&n, _)| n)
+        .collect();
+    let many = black.iter().filter(|&&n| n >= 5).count();
+    println!(
+        "{many} of {} black bed beads with ≥ 5 contacts",
+        black.len()
     );
-    assert!(contacts.iter().all(|&n| n >= 2));
+    assert!(
+        many * 2 > black.len(),
+        "{many} of {} black bed beads with ≥ 5 contacts",
+        black.len()
+    );
+    let loose: Vec<_> = contacts
+        .iter()
+        .zip(&bed)
+        .filter(|(n, _)| **n < 2)
+        .map(|(n, b)| (n, b.class, b.pos_px))
+        .collect();
+    assert!(
+        loose.is_empty(),
+        "bed beads with fewer than 2 contacts: {loose:?}"
+    );
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! contacts with the other beads ([`super::pile`]) limit it.
 
 use rand::RngExt;
-use sillage_core::{MotionState, ObjectClass, Point2, RngStream, TrackId};
+use sillage_core::{MotionState, ObjectClass, Point2, RngStream, TrackId, Vec2};
 
 use super::BedloadSceneParams;
 use super::bed::BedSurface;
@@ -51,7 +51,7 @@ pub(crate) fn uniform(rng: &mut RngStream, [min, max]: [f64; 2]) -> f64 {
 pub(crate) struct Dynamics<'a> {
     /// The scene's parameters.
     pub params: &'a BedloadSceneParams,
-    /// The surface of the static bed.
+    /// The surface of the deposit: the static bed and the creeping layers.
     pub surface: &'a BedSurface,
     /// The surface of the bed and of the mobile beads that stay on it this frame, as they
     /// were at its start: what saltating beads fly over.
@@ -113,8 +113,19 @@ pub(crate) struct Mover {
     /// Its place in contact with the others, px (a resting bead is reported off it by its
     /// jitter).
     pub anchor: Point2,
-    /// The state of its last step.
+    /// The state of its last step, drawn from the transition table.
     pub state: MotionState,
+    /// The motion state its last step is reported in: its `state`, but rolling where a
+    /// resting bead was carried by the creeping layer under it (Eq. (4): it moves).
+    pub label: MotionState,
+    /// Its place at the start of the frame, before the creeping layer carried it, px: no
+    /// bead moves farther than `MAX_STEP_PX` from it in a frame.
+    pub origin: Point2,
+    /// Whether it lay on the deposit or on beads at the end of the last frame (not in the
+    /// air): the creeping layer carries it.
+    pub grounded: bool,
+    /// How far the creeping layer carried it this frame, px.
+    pub carried: Vec2,
     /// Its speed along x while rolling, px/frame.
     rolling_speed: f64,
     /// How far it fell in the last frame while in the air (not in a saltation), px: its
@@ -139,6 +150,10 @@ impl Mover {
             class,
             anchor: dynamics.on_surface(x, class),
             state,
+            label: state,
+            origin: dynamics.on_surface(x, class),
+            grounded: false,
+            carried: Vec2::ZERO,
             rolling_speed: uniform(rng, dynamics.params.rolling_speed_px_per_frame),
             fall_px: 0.0,
             flight: Flight::default(),
@@ -168,12 +183,31 @@ impl Mover {
         }
     }
 
-    /// A resting bead that the contacts moved (its support went away and it falls, or it
-    /// slides off a bead left steep) is set rolling, at the speed of its last roll.
-    pub(crate) fn fall(&mut self) {
-        if self.state == MotionState::Resting {
+    /// Starts a frame: a grounded bead is carried by `dx` along x with the deposit under
+    /// it, keeping its height above the deposit's surface (`before` the frame, `after`);
+    /// `origin` is where it was.
+    pub(crate) fn carry(&mut self, dx: f64, before: &BedSurface, after: &BedSurface) {
+        self.origin = self.anchor;
+        if self.grounded && dx != 0.0 {
+            let x = self.anchor.x + dx;
+            let rise = after.y(x, self.class) - before.y(self.anchor.x, self.class);
+            self.anchor = Point2::new(x, self.anchor.y + rise);
+        }
+        self.carried = self.anchor - self.origin;
+    }
+
+    /// Ends a frame: a resting bead that the contacts moved (its support went away and it
+    /// falls, or it slides off a bead left steep) is set rolling, at the speed of its last
+    /// roll; one only carried (by more than `still_px`) is reported rolling.
+    pub(crate) fn settled(&mut self, moved_by_contacts: bool, still_px: f64) {
+        if moved_by_contacts && self.state == MotionState::Resting {
             self.state = MotionState::Rolling;
         }
+        self.label = if self.state == MotionState::Resting && self.carried.norm() > still_px {
+            MotionState::Rolling
+        } else {
+            self.state
+        };
     }
 
     /// Enters state `next` and returns its move, which the pile then limits by the
@@ -195,7 +229,7 @@ impl Mover {
             if !loaded {
                 self.launch(dynamics, motion);
                 let to = self.fly(dynamics, motion);
-                if to.distance(self.anchor) <= MAX_STEP_PX {
+                if to.distance(self.origin) <= MAX_STEP_PX {
                     self.state = next;
                     return Proposal::Air {
                         to,

@@ -23,13 +23,16 @@
 //! its way. The only exception to the contact distance is a pile reaching the top of the
 //! frame, where centres are kept inside it (not with the default parameters).
 
-use sillage_core::{BLACK_BEAD_CLASS, MotionState, Point2, TRANSPARENT_BEAD_CLASS};
+use sillage_core::{BLACK_BEAD_CLASS, MotionState, Point2, TRANSPARENT_BEAD_CLASS, Vec2};
 
 use super::BedloadSceneParams;
 use super::motion::{Dynamics, Mover};
 
 /// Tolerance of the contact tests, px (rounding only).
 const EPS_PX: f64 = 1e-9;
+
+/// Most pushes that free a bead from the placed beads it overlaps (each from one of them).
+const PUSHES: usize = 4;
 
 /// Tolerance of a flying bead's contacts, px: the bed surface is tabulated within it, and
 /// the settling leaves beads in contact off it by less.
@@ -246,6 +249,51 @@ impl Pile {
         })
     }
 
+    /// A placed bead that bead `i` at `p` would come closer to than their contact distance.
+    fn overlapped(
+        &self,
+        movers: &[Mover],
+        i: usize,
+        p: Point2,
+        params: &BedloadSceneParams,
+    ) -> Option<usize> {
+        self.near(p.x).find(|&j| {
+            let d = params.contact_distance_px(movers[i].class, movers[j].class);
+            self.status[j] == Status::New && j != i && movers[j].anchor.distance(p) < d - EPS_PX
+        })
+    }
+
+    /// Bead `i` at `place`, pushed straight away from the placed beads it overlaps (one that
+    /// a carried bead rose into) to their contact distance, into the air to fall from there.
+    fn pushed_out(
+        &self,
+        movers: &[Mover],
+        i: usize,
+        place: Placement,
+        params: &BedloadSceneParams,
+    ) -> Placement {
+        let mut pos = place.pos;
+        for _ in 0..PUSHES {
+            let Some(j) = self.overlapped(movers, i, pos, params) else {
+                break;
+            };
+            let d = params.contact_distance_px(movers[i].class, movers[j].class);
+            let away = pos - movers[j].anchor;
+            let norm = away.norm();
+            let unit = if norm > EPS_PX {
+                away * (1.0 / norm)
+            } else {
+                Vec2::new(0.0, -1.0)
+            };
+            pos = movers[j].anchor + unit * d;
+        }
+        if pos == place.pos {
+            place
+        } else {
+            Placement::air(pos)
+        }
+    }
+
     /// The place of bead `i` on the envelope at `x` ([`Pile::envelope`]).
     fn on_envelope(
         &self,
@@ -292,7 +340,7 @@ impl Pile {
             return if self.steady(movers, i, &start, params) {
                 start
             } else {
-                self.slide(movers, i, start, Some(from), dynamics)
+                self.slide(movers, i, start, true, dynamics)
             };
         }
         let height = |p: Point2| dynamics.surface.y(p.x, class) - p.y;
@@ -314,34 +362,33 @@ impl Pile {
             if !free(&place, &next) {
                 break;
             }
-            let (reached, on) = self.roll_to(movers, i, from, place, next, params);
+            let (reached, on) = self.roll_to(movers, i, place, next, params);
             place = reached;
             if !on {
                 break;
             }
         }
         if !place.airborne && !self.steady(movers, i, &place, params) {
-            place = self.slide(movers, i, place, Some(from), dynamics);
+            place = self.slide(movers, i, place, true, dynamics);
         }
         place
     }
 
-    /// Bead `i`, which started the frame at `from` and has got to `place` on the envelope,
-    /// goes on to `next`, the envelope 0.5 px further: the place reached and whether it may go
-    /// on. It stops at `place` where `next` lies farther than `MAX_STEP_PX` from `from` (a
-    /// capped speed); where the envelope drops by more than `LEDGE_PX` (a ledge: the bead
+    /// Bead `i`, which has got to `place` on the envelope, goes on to `next`, the envelope
+    /// 0.5 px further: the place reached and whether it may go on. It stops at `place` where
+    /// `next` lies farther than `MAX_STEP_PX` from where the bead started the frame (its
+    /// `origin`, a capped speed); where the envelope drops by more than `LEDGE_PX` (a ledge: the bead
     /// runs off the bead it lay on) it leaves the surface, into the air above `next` at
     /// `place`'s height, and falls from there in the next frames.
     fn roll_to(
         &self,
         movers: &[Mover],
         i: usize,
-        from: Point2,
         place: Placement,
         next: Placement,
         params: &BedloadSceneParams,
     ) -> (Placement, bool) {
-        if next.pos.distance(from) > MAX_STEP_PX {
+        if next.pos.distance(movers[i].origin) > MAX_STEP_PX {
             return (place, false);
         }
         if next.pos.y - place.pos.y > LEDGE_PX {
@@ -360,7 +407,8 @@ impl Pile {
     /// fall of the last frame plus `gravity_px_per_frame2` (the fall speed grows under the
     /// buoyancy-reduced gravity), at most `MAX_STEP_PX` (a capped speed), landing on the
     /// first bead or the bed under it when it gets there. Wedged between beads on its sides,
-    /// it slides down the envelope where it can.
+    /// it slides down the envelope where it can (lifted first out of a bead that rose into
+    /// it).
     fn free_fall(&self, movers: &[Mover], i: usize, dynamics: &Dynamics<'_>) -> Placement {
         let from = movers[i].anchor;
         let params = dynamics.params;
@@ -379,11 +427,19 @@ impl Pile {
             }
         }
         if room <= SUPPORT_TOLERANCE_PX {
-            let start = Placement {
-                pos: from,
-                ..self.on_envelope(movers, i, from.x, dynamics)
+            // Sunk into the bead under it (the deposit rose under that one): lifted onto it,
+            // or onto the envelope if a placed bead beside it is in the way.
+            let envelope = self.on_envelope(movers, i, from.x, dynamics);
+            let lifted = Point2::new(from.x, from.y + room.min(0.0));
+            let start = if self.overlapped(movers, i, lifted, params).is_some() {
+                envelope
+            } else {
+                Placement {
+                    pos: lifted,
+                    ..envelope
+                }
             };
-            return self.slide(movers, i, start, Some(from), dynamics);
+            return self.slide(movers, i, start, true, dynamics);
         }
         let fall = (movers[i].fall_px + params.gravity_px_per_frame2).min(MAX_STEP_PX);
         let pos = Point2::new(from.x, from.y + fall.min(room.max(0.0)));
@@ -421,14 +477,14 @@ impl Pile {
     /// The place of a bead that slides from `start` down the envelope's slope by steps of 0.5 px
     /// to the bottom of the dip, at most one bead diameter away, stopping before a bead not
     /// placed yet: dropped beads pack as a deposit does rather than stick where they first
-    /// touch, and beads left on the side of another slide off. A bead that was at `from`
-    /// at the start of the frame (not a newcomer) moves as [`Pile::roll_to`] lets it.
+    /// touch, and beads left on the side of another slide off. A `moving` bead (not a
+    /// newcomer) moves as [`Pile::roll_to`] lets it.
     fn slide(
         &self,
         movers: &[Mover],
         i: usize,
         start: Placement,
-        from: Option<Point2>,
+        moving: bool,
         dynamics: &Dynamics<'_>,
     ) -> Placement {
         let params = dynamics.params;
@@ -451,11 +507,11 @@ impl Pile {
             if next.pos.y <= best.pos.y || self.blocked(movers, i, next.pos, params) {
                 break;
             }
-            let Some(from) = from else {
+            if !moving {
                 best = next;
                 continue;
-            };
-            let (reached, on) = self.roll_to(movers, i, from, best, next, params);
+            }
+            let (reached, on) = self.roll_to(movers, i, best, next, params);
             best = reached;
             if !on {
                 break;
@@ -494,9 +550,11 @@ impl Pile {
     ) -> (Placement, bool) {
         let from = movers[i].anchor;
         let length = from.distance(to);
-        let capped = length > MAX_STEP_PX;
+        // What is left of the frame's largest step after the carry of a take-off.
+        let budget = MAX_STEP_PX - movers[i].carried.norm();
+        let capped = length > budget;
         let end = if capped {
-            from + (to - from) * (MAX_STEP_PX / length)
+            from + (to - from) * (budget / length)
         } else {
             to
         };
@@ -506,19 +564,19 @@ impl Pile {
                 .rev()
                 .map(|k| from + (end - from) * (k as f64 / steps as f64))
                 .find(|&p| self.clear(movers, i, p, dynamics))
-                .unwrap_or(from);
+                .unwrap_or_else(|| self.lifted(movers, i, budget, dynamics));
             return (Placement::air(reached), true);
         }
         if !lands {
             return (Placement::air(end), capped);
         }
         let below = self.on_envelope(movers, i, end.x, dynamics);
-        if below.pos.distance(from) <= MAX_STEP_PX {
+        if below.pos.distance(from) <= budget {
             return (below, false);
         }
         // The lowest point above `below` within reach: `end` is, so the root is real.
         let run = end.x - from.x;
-        let y = from.y + (MAX_STEP_PX * MAX_STEP_PX - run * run).max(0.0).sqrt();
+        let y = from.y + (budget * budget - run * run).max(0.0).sqrt();
         let low = Point2::new(end.x, y.max(end.y));
         let place = if self.clear(movers, i, low, dynamics) {
             low
@@ -526,6 +584,18 @@ impl Pile {
             end
         };
         (Placement::air(place), false)
+    }
+
+    /// The lowest point above flying bead `i`, by steps of 0.5 px up to `reach`, where it is
+    /// clear of the others (a bead carried up by the creeping layer rose into it); its place
+    /// if there is none.
+    fn lifted(&self, movers: &[Mover], i: usize, reach: f64, dynamics: &Dynamics<'_>) -> Point2 {
+        let from = movers[i].anchor;
+        let steps = (reach / SLIDE_STEP_PX).floor() as usize;
+        (1..=steps)
+            .map(|k| Point2::new(from.x, from.y - k as f64 * SLIDE_STEP_PX))
+            .find(|&p| self.clear(movers, i, p, dynamics))
+            .unwrap_or(from)
     }
 
     /// Whether flying bead `i` was stopped short of its hop's point in the last settling.
@@ -590,13 +660,18 @@ impl Pile {
                             |a, b| if b.0 > a.0 { b } else { a },
                         );
                     let start = self.on_envelope(movers, i, lowest.1, dynamics);
-                    self.slide(movers, i, start, None, dynamics)
+                    self.slide(movers, i, start, false, dynamics)
                 }
                 Proposal::Air { to, lands } => {
                     let (place, stopped) = self.fly(movers, i, to, lands, dynamics);
                     self.stopped[i] = stopped;
                     place
                 }
+            };
+            // Flying beads were kept clear of every bead by `fly`.
+            let place = match proposals[i] {
+                Proposal::Air { .. } => place,
+                _ => self.pushed_out(movers, i, place, params),
             };
             if self.status[i] == Status::Old {
                 self.remove(i);
@@ -608,6 +683,7 @@ impl Pile {
             } else {
                 0.0
             };
+            movers[i].grounded = !place.airborne;
             self.status[i] = Status::New;
             self.supports[i] = place.supports;
             self.insert(i, place.pos.x);
