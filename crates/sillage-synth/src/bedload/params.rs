@@ -43,8 +43,9 @@ pub struct BedloadSceneParams {
     /// does in Eq. (11), starting more often, so that the layers slip 63 % of the time and
     /// the black beads roll about as often as the real sequence's, 35 %).
     pub creep_switching: [f64; 2],
-    /// Fraction of the transparent beads lodged in the two top static layers of the bed,
-    /// in the place of a black bead, lying on the two beads below, always resting (default 0.7: small beads sink into the
+    /// Fraction of the transparent beads lodged in the static bed (its top layer and the
+    /// third from the top), in the place of a black bead, lying on the two black beads below,
+    /// always resting (default 0.7: small beads sink into the
     /// coarse bed; 76 % of the real sequence's transparent beads rest, most of them within
     /// its static bed).
     pub transparent_in_bed: f64,
@@ -265,8 +266,8 @@ impl BedloadSceneParams {
         let room = lodging_site_count(self);
         if lodged > room {
             let message = format!(
-                "lodges {lodged} transparent beads in the {room} sites of the two top static \
-                 layers; lower it or add layers"
+                "lodges {lodged} transparent beads in the {room} sites of the top static layer \
+                 and the third from the top; lower it or add layers"
             );
             return Err(Error::parameter(
                 "transparent_in_bed",
