@@ -87,8 +87,9 @@ fn ids_are_unique_never_reused_and_the_counts_stay_constant() {
         gone.extend(previous.difference(&ids));
         previous = ids;
     }
-    // The contacts hold beads back: about 0.04 crossings per frame (the real sequence: 2
-    // new trajectories in 20 frames), 0.08 without them.
+    // The creeping layers and the beads they carry cross the frame (the real sequence: 1
+    // entry and 1 exit in its 10 frames with truth; Σ|vx| / 1280 = 0.21 per frame).
+    println!("{births} beads crossed the frame in 1500 frames");
     assert!(births > 40, "only {births} beads crossed the frame");
     assert_eq!(births, gone.len());
 }
@@ -114,16 +115,17 @@ fn positions_stay_in_the_frame_and_displacements_below_the_search_radius() {
             }
         }
     }
-    println!("{beyond} of {moves} moves beyond 31.05 px, largest {largest:.1} px");
-    // Only saltations rebounding off a pile and beads falling where their support took off
-    // jump further (the scene keeps moves within 25 px where it can): 0.3 % of the moves.
-    assert!(
-        (beyond as f64) < 5e-3 * moves as f64,
+    println!("{beyond} of {moves} moves beyond 31.05 px, largest {largest:.2} px");
+    // Beads move continuously: a bead that loses its support falls under gravity, a
+    // saltation stops against a bead in its way, and no move exceeds 25 px.
+    assert_eq!(
+        beyond, 0,
         "{beyond} of {moves} moves beyond the search radius"
     );
+    assert!(largest <= 25.0 + 1e-9, "a move of {largest} px");
     assert!(
-        largest > 15.0,
-        "saltations should reach 10-25 px per frame: {largest}"
+        largest > 20.0,
+        "saltations and falls should reach 20-25 px per frame: {largest}"
     );
 }
 
@@ -136,12 +138,13 @@ fn motion_agrees_with_the_motion_state() {
         };
         let jitter = params.resting_jitter_px;
         let clearance = params.hop_clearance_px;
+        let hop_speed = params.saltation_speed_px_per_frame[0];
         let mut scene = BedloadScene::new(params).unwrap();
         let mut frames_seen = Vec::new();
         while let Some(frame) = scene.next_frame() {
             frames_seen.push(frame);
         }
-        let (mut in_flight, mut saltating, mut rolling) = (0, 0, 0);
+        let (mut in_flight, mut saltating, mut rolling, mut fast) = (0, 0, 0, 0);
         let (mut advancing, mut largest_roll, mut backwards) = (0, 0.0f64, 0);
         for bead in frames_seen.iter().flat_map(|f| &f.beads) {
             let surface = scene.surface_y(bead.pos_px.x, bead.class);
@@ -155,12 +158,10 @@ fn motion_agrees_with_the_motion_state() {
                 MotionState::Resting => assert!(v.norm() <= jitter + 1e-12, "{v:?}"),
                 MotionState::Rolling => {
                     rolling += 1;
-                    // On the bed or on other beads; downstream, held back by a bead, or back
-                    // into the dip behind one it was left hanging on (8 of 117 000 steps).
+                    // On the bed, on other beads or falling onto them; downstream, held back
+                    // by a bead, or back into the dip behind one it was left hanging on.
                     assert!(bead.pos_px.y <= surface + 1e-9, "below the bed: {bead:?}");
-                    assert!(v.x * f64::from(flow_direction) >= -45.0, "{v:?}");
-                    // Within 25 px unless a fall is held up by a bead not placed yet.
-                    assert!(v.norm() < 70.0, "rolling by {v:?}");
+                    assert!(v.norm() <= 25.0 + 1e-9, "rolling by {v:?}");
                     if v.x * f64::from(flow_direction) < -jitter {
                         backwards += 1;
                     }
@@ -172,7 +173,11 @@ fn motion_agrees_with_the_motion_state() {
                 MotionState::Saltating => {
                     saltating += 1;
                     assert!(bead.pos_px.y <= surface + 1e-9, "below the bed: {bead:?}");
-                    assert!(v.x * f64::from(flow_direction) >= 10.0 - jitter, "{v:?}");
+                    // Downstream; at the hop's speed unless stopped against a bead.
+                    assert!(v.x * f64::from(flow_direction) >= -1e-9, "{v:?}");
+                    if v.x * f64::from(flow_direction) >= hop_speed - jitter {
+                        fast += 1;
+                    }
                     if bead.pos_px.y <= surface - clearance + 1e-9 {
                         in_flight += 1;
                     }
@@ -199,6 +204,8 @@ fn motion_agrees_with_the_motion_state() {
             advancing * 10 > rolling,
             "{advancing} of {rolling} advancing"
         );
+        println!("{fast} of {saltating} saltating steps at {hop_speed} px/frame or more");
+        assert!(fast * 10 > saltating * 8, "{fast} of {saltating} fast");
         // Most saltating frames are in the air, the others are contacts (take-off, rebound
         // or landing on the surface).
         assert!(
@@ -210,7 +217,16 @@ fn motion_agrees_with_the_motion_state() {
 
 #[test]
 fn state_transitions_follow_the_table() {
-    let params = frames(4000, 5);
+    // The table drives the mobile beads' own motion; a creeping layer carries the beads
+    // lying on it, which are then reported rolling whatever their state (the motion test
+    // checks that). The table's frequencies are measured without the carry: on a static bed
+    // of 6 layers, all black.
+    let params = BedloadSceneParams {
+        bed_layers: 6,
+        creeping_layers: 0,
+        transparent_in_bed: 0.0,
+        ..frames(4000, 5)
+    };
     let table = params.transition_probabilities;
     let mut counts = [[0usize; 3]; 3];
     let mut previous: HashMap<TrackId, MotionState> = HashMap::new();
@@ -275,13 +291,34 @@ fn bed_beads_touch_their_neighbours() {
         }
         contacts.push(n);
     }
-    let many = contacts.iter().filter(|&&n| n >= 5).count();
-    assert!(
-        many * 2 > bed.len(),
-        "{many} of {} bed beads with ≥ 5 contacts",
-        bed.len()
+    // The black lattice: most of its beads touch 5 or more (a transparent bead lodged in a
+    // site touches the two below it; the real frames: 62 % of the resting black beads).
+    let black: Vec<usize> = contacts
+        .iter()
+        .zip(&bed)
+        .filter(|(_, b)| b.class == BLACK_BEAD_CLASS)
+        .map(|(&n, _)| n)
+        .collect();
+    let many = black.iter().filter(|&&n| n >= 5).count();
+    println!(
+        "{many} of {} black bed beads with ≥ 5 contacts",
+        black.len()
     );
-    assert!(contacts.iter().all(|&n| n >= 2));
+    assert!(
+        many * 2 > black.len(),
+        "{many} of {} black bed beads with ≥ 5 contacts",
+        black.len()
+    );
+    let loose: Vec<_> = contacts
+        .iter()
+        .zip(&bed)
+        .filter(|(n, _)| **n < 2)
+        .map(|(n, b)| (n, b.class, b.pos_px))
+        .collect();
+    assert!(
+        loose.is_empty(),
+        "bed beads with fewer than 2 contacts: {loose:?}"
+    );
 }
 
 #[test]

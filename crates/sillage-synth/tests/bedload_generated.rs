@@ -141,6 +141,101 @@ impl Distributions {
     }
 }
 
+/// What the motion of a sequence looks like, as its ground truth tells (beads with a
+/// velocity and a known state).
+#[derive(Debug)]
+struct MotionStatistics {
+    /// Per class (black, transparent): fractions of the beads resting, rolling, saltating.
+    states: [[f64; 3]; 2],
+    /// Kinematic flux: Σ|vx| over the beads of a frame divided by the frame's width, beads
+    /// crossing it per frame, averaged over the frames.
+    flux: f64,
+    /// Median and 95 % quantile of the rolling beads' speeds, px/frame.
+    rolling: [f64; 2],
+    /// Median and 5 % quantile of the saltating beads' speeds, px/frame.
+    saltating: [f64; 2],
+}
+
+impl MotionStatistics {
+    /// The statistics of `frames`, `width` px wide.
+    fn of(frames: &[BedloadFrame], width: f64) -> Self {
+        let mut counts = [[0usize; 3]; 2];
+        let mut speeds: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
+        let (mut flux, mut n_frames) = (0.0, 0);
+        for frame in frames {
+            let mut sum = 0.0;
+            let mut seen = false;
+            for bead in &frame.beads {
+                let Some(v) = bead.vel_px_per_frame else {
+                    continue;
+                };
+                let state = match bead.motion_state {
+                    MotionState::Resting => 0,
+                    MotionState::Rolling => 1,
+                    MotionState::Saltating => 2,
+                    MotionState::Unknown => continue,
+                };
+                seen = true;
+                sum += v.x.abs();
+                counts[usize::from(bead.class != BLACK_BEAD_CLASS)][state] += 1;
+                if state > 0 {
+                    speeds[state - 1].push(v.norm());
+                }
+            }
+            if seen {
+                flux += sum / width;
+                n_frames += 1;
+            }
+        }
+        let states = counts.map(|row| {
+            let n: usize = row.iter().sum();
+            row.map(|k| k as f64 / n.max(1) as f64)
+        });
+        Self {
+            states,
+            flux: flux / f64::from(n_frames.max(1)),
+            rolling: [quantile(&speeds[0], 0.5), quantile(&speeds[0], 0.95)],
+            saltating: [quantile(&speeds[1], 0.5), quantile(&speeds[1], 0.05)],
+        }
+    }
+}
+
+#[test]
+fn generated_motion_matches_the_real_sequence() {
+    // The real frames: 2-10 (frame 1 has no velocities), about 400 beads each.
+    let real = MotionStatistics::of(&real_configurations(), 1280.0);
+    println!("real: {real:.3?}");
+    let params = BedloadSceneParams {
+        n_frames: 1500,
+        seed: 13,
+        ..BedloadSceneParams::default()
+    };
+    let frames: Vec<BedloadFrame> = BedloadScene::new(params).unwrap().collect();
+    let generated = MotionStatistics::of(&frames, 1280.0);
+    println!("generated: {generated:.3?}");
+    // The real states over 3,500 beads, to ±10 points per state and class.
+    for class in 0..2 {
+        for state in 0..3 {
+            let (g, r) = (generated.states[class][state], real.states[class][state]);
+            assert!(
+                (g - r).abs() <= 0.10,
+                "class {class}, state {state}: {g:.3} against {r:.3}"
+            );
+        }
+    }
+    // The flux within a factor 1.5 of the real one (one sequence of 9 steps).
+    let ratio = generated.flux / real.flux;
+    assert!(
+        (1.0 / 1.5..=1.5).contains(&ratio),
+        "flux {ratio:.2} × the real"
+    );
+    // Speeds: the real ones are whole pixels, hence the half-pixel tolerance of the
+    // median; the quantiles of a few hundred steps within 1.5 px/frame.
+    assert!((generated.rolling[0] - real.rolling[0]).abs() <= 0.5);
+    assert!((generated.rolling[1] - real.rolling[1]).abs() <= 1.5);
+    assert!((generated.saltating[0] - real.saltating[0]).abs() <= 3.0);
+}
+
 #[test]
 fn the_contact_factors_are_the_real_frames_typical_distances() {
     let real = Distributions::of(&real_configurations());

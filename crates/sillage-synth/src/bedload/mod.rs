@@ -5,11 +5,13 @@
 //!
 //! - [`BedloadScene`] ([`BedloadSceneParams`]): a static bed of black beads in hexagonal layers
 //!   in contact at the bottom of the frame (6 contacts inside the bed, as the motion-state
-//!   rule `nbN ≥ 5` expects), and mobile beads, black and transparent, resting on it or on
-//!   each other, rolling downstream over it and over lower beads, or saltating above them in
-//!   ballistic hops, their states switching per frame by the transition table (default
-//!   Eq. (11)). The flume being about one bead wide (§4.1), no two beads come closer than
-//!   their contact distance, measured on the real frames
+//!   rule `nbN ≥ 5` expects) with transparent beads lodged in its top layers, creeping layers
+//!   of black beads slipping downstream over it in stop-and-go spells (the real sequence's
+//!   rolling deposit), and mobile beads, black and transparent, resting on them or on each
+//!   other (carried by the top layer), rolling downstream over them and over lower beads, or
+//!   saltating above them in ballistic hops, their states switching per frame by the
+//!   transition table (default Eq. (11)). The flume being about one bead wide (§4.1), no two
+//!   beads come closer than their contact distance, measured on the real frames
 //!   ([`BedloadSceneParams::contact_factors`]). Beads leaving downstream come back upstream
 //!   as new identities. Yields [`BedloadFrame`]s of [`TrueBead`]s.
 //! - [`BeadDetectionModel`] ([`BedloadDetectionParams`]): per frame, the detections of both
@@ -32,7 +34,8 @@
 //! let frames = generate_bedload(params, BedloadDetectionParams::default())?;
 //! assert_eq!(frames.len(), 3);
 //! assert_eq!(frames[2].truth.beads.len(), 400);
-//! // The bed: 6 layers of 43 black beads, always resting.
+//! // The static bed: 6 layers of 43 sites, 70 of which hold a transparent bead, always
+//! // resting; over it, 2 creeping layers of 42 black beads.
 //! let bed = frames[2].truth.beads.iter().filter(|b| b.in_bed).count();
 //! assert_eq!(bed, 258);
 //! assert!(frames[2].truth.beads.iter().filter(|b| b.in_bed).all(|b| b.motion_state == MotionState::Resting));
@@ -42,6 +45,7 @@
 //! ```
 
 mod bed;
+mod creep;
 mod detection_params;
 mod detections;
 mod motion;

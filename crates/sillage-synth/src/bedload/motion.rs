@@ -3,7 +3,7 @@
 //! contacts with the other beads ([`super::pile`]) limit it.
 
 use rand::RngExt;
-use sillage_core::{MotionState, ObjectClass, Point2, RngStream, TrackId};
+use sillage_core::{MotionState, ObjectClass, Point2, RngStream, TrackId, Vec2};
 
 use super::BedloadSceneParams;
 use super::bed::BedSurface;
@@ -51,7 +51,7 @@ pub(crate) fn uniform(rng: &mut RngStream, [min, max]: [f64; 2]) -> f64 {
 pub(crate) struct Dynamics<'a> {
     /// The scene's parameters.
     pub params: &'a BedloadSceneParams,
-    /// The surface of the static bed.
+    /// The surface of the deposit: the static bed and the creeping layers.
     pub surface: &'a BedSurface,
     /// The surface of the bed and of the mobile beads that stay on it this frame, as they
     /// were at its start: what saltating beads fly over.
@@ -113,10 +113,24 @@ pub(crate) struct Mover {
     /// Its place in contact with the others, px (a resting bead is reported off it by its
     /// jitter).
     pub anchor: Point2,
-    /// The state of its last step.
+    /// The state of its last step, drawn from the transition table.
     pub state: MotionState,
+    /// The motion state its last step is reported in: its `state`, but rolling where a
+    /// resting bead was carried by the creeping layer under it (Eq. (4): it moves).
+    pub label: MotionState,
+    /// Its place at the start of the frame, before the creeping layer carried it, px: no
+    /// bead moves farther than `MAX_STEP_PX` from it in a frame.
+    pub origin: Point2,
+    /// Whether it lay on the deposit or on beads at the end of the last frame (not in the
+    /// air): the creeping layer carries it.
+    pub grounded: bool,
+    /// How far the creeping layer carried it this frame, px.
+    pub carried: Vec2,
     /// Its speed along x while rolling, px/frame.
     rolling_speed: f64,
+    /// How far it fell in the last frame while in the air (not in a saltation), px: its
+    /// fall speed, which gravity raises in the next frame ([`super::pile::Pile`]).
+    pub fall_px: f64,
     flight: Flight,
 }
 
@@ -136,7 +150,12 @@ impl Mover {
             class,
             anchor: dynamics.on_surface(x, class),
             state,
+            label: state,
+            origin: dynamics.on_surface(x, class),
+            grounded: false,
+            carried: Vec2::ZERO,
             rolling_speed: uniform(rng, dynamics.params.rolling_speed_px_per_frame),
+            fall_px: 0.0,
             flight: Flight::default(),
         }
     }
@@ -164,20 +183,40 @@ impl Mover {
         }
     }
 
-    /// A resting bead whose support went away (it took off) falls onto what lies below: it
-    /// is set rolling, at the speed of its last roll.
-    pub(crate) fn fall(&mut self) {
-        if self.state == MotionState::Resting {
+    /// Starts a frame: a grounded bead is carried by `dx` along x with the deposit under
+    /// it, keeping its height above the deposit's surface (`before` the frame, `after`);
+    /// `origin` is where it was.
+    pub(crate) fn carry(&mut self, dx: f64, before: &BedSurface, after: &BedSurface) {
+        self.origin = self.anchor;
+        if self.grounded && dx != 0.0 {
+            let x = self.anchor.x + dx;
+            let rise = after.y(x, self.class) - before.y(self.anchor.x, self.class);
+            self.anchor = Point2::new(x, self.anchor.y + rise);
+        }
+        self.carried = self.anchor - self.origin;
+    }
+
+    /// Ends a frame: a resting bead that the contacts moved (its support went away and it
+    /// falls, or it slides off a bead left steep) is set rolling, at the speed of its last
+    /// roll; one only carried (by more than `still_px`) is reported rolling.
+    pub(crate) fn settled(&mut self, moved_by_contacts: bool, still_px: f64) {
+        if moved_by_contacts && self.state == MotionState::Resting {
             self.state = MotionState::Rolling;
         }
+        self.label = if self.state == MotionState::Resting && self.carried.norm() > still_px {
+            MotionState::Rolling
+        } else {
+            self.state
+        };
     }
 
     /// Enters state `next` and returns its move, which the pile then limits by the
     /// contacts: resting stays put, rolling advances by its speed along x (a `loaded` bead,
-    /// which another lies on, stays put), saltating follows its hop, planned over the pile's top `dynamics.top`
-    /// to land on it exactly on the saltation's last frame (or earlier on a bead that has
-    /// moved in the way, see [`Mover::end_flight_frame`]). A bead whose first hop would
-    /// move it by more than `MAX_STEP_PX` (out of a deep hole) does not take off.
+    /// which another lies on, stays put), saltating follows its hop, planned over the pile's
+    /// top `dynamics.top` to land on it exactly on the saltation's last frame (or earlier on
+    /// a bead that has moved in the way, see [`Mover::end_flight_frame`]). A bead whose
+    /// first hop would move it by more than `MAX_STEP_PX` (out of a deep hole), or which
+    /// another lies on, does not take off.
     pub(crate) fn step(
         &mut self,
         next: MotionState,
@@ -187,17 +226,19 @@ impl Mover {
     ) -> Proposal {
         let mut next = next;
         if next == MotionState::Saltating && self.state != MotionState::Saltating {
-            self.launch(dynamics, motion);
-            let to = self.fly(dynamics, motion);
-            if to.distance(self.anchor) <= MAX_STEP_PX {
-                self.state = next;
-                return Proposal::Air {
-                    to,
-                    lands: self.flight.frames_left == 0,
-                };
+            if !loaded {
+                self.launch(dynamics, motion);
+                let to = self.fly(dynamics, motion);
+                if to.distance(self.origin) <= MAX_STEP_PX {
+                    self.state = next;
+                    return Proposal::Air {
+                        to,
+                        lands: self.flight.frames_left == 0,
+                    };
+                }
             }
-            // Too deep in a hole between higher beads to leave it but steeply: it stays in
-            // its state (a take-off is 1 % per frame in Eq. (11)).
+            // Held down by a bead on it, or too deep in a hole between higher beads to leave
+            // it but steeply: it stays in its state.
             next = self.state;
         }
         let proposal = match next {

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 use sillage_core::{BLACK_BEAD_CLASS, Error, ObjectClass, Result};
 
-use super::bed::{bed_bead_count, lowest_surface_y};
+use super::bed::{bed_black_count, lodged_count, lodging_site_count, lowest_surface_y};
 
 /// Parameters of the true bead motion. Defaults follow the paper's experimental sequence
 /// ExpSeq (§4.2) and the authors' BeadTracking code where they give a value, and documented
@@ -22,9 +22,33 @@ pub struct BedloadSceneParams {
     pub n_black: usize,
     /// Transparent (small, 4 mm) beads in every frame, all mobile (default 100, §4.2).
     pub n_transparent: usize,
-    /// Full hexagonal layers of resting black beads that make the bed (default 6: 6 × 43 =
-    /// 258 beads across 1280 px, which leaves 42 mobile black beads).
+    /// Full hexagonal layers of black beads that make the bed, the creeping ones included
+    /// (default 8: the real sequence's deposit, its beads resting or rolling below the
+    /// saltating ones, fills the frame up to y ≈ 110 px, MMPF+ Fig. 1).
     pub bed_layers: usize,
+    /// Top layers of the bed that creep downstream over the static ones below, each one
+    /// spanning the frame (default 2: the real sequence's rolling beads, about a third of
+    /// the black ones, lie in the 2–3 bead layers above its static bed, y ≈ 110–180 px,
+    /// the top one carrying the mobile beads).
+    pub creeping_layers: usize,
+    /// Range `[min, max]` of the speed at which the top creeping layer slips over the layer
+    /// below it, drawn at the start of each of its moving spells, px/frame; the layer `k`
+    /// (1 at the bottom) of `n` slips at `k/n` of such a speed, and each layer is carried by
+    /// those below (default [0.2, 2.6]: the real sequence's beads move faster the higher
+    /// they lie, and its rolling ones by a median 1 px/frame, 95 % below 4.5; at most
+    /// 10 px/frame over all the layers).
+    pub creep_speed_px_per_frame: [f64; 2],
+    /// Per-frame probabilities that a stopped creeping layer starts slipping over the layer
+    /// below and that a slipping one stops (default [0.12, 0.07]: stopping as a rolling bead
+    /// does in Eq. (11), starting more often, so that the layers slip 63 % of the time and
+    /// the black beads roll about as often as the real sequence's, 35 %).
+    pub creep_switching: [f64; 2],
+    /// Fraction of the transparent beads lodged in the static bed (its top layer and the
+    /// third from the top), in the place of a black bead, lying on the two black beads below,
+    /// always resting (default 0.7: small beads sink into the
+    /// coarse bed; 76 % of the real sequence's transparent beads rest, most of them within
+    /// its static bed).
+    pub transparent_in_bed: f64,
     /// Black bead radius, px (default 15: BeadTracking's radBlackBeadPx at 2.056e-4 m/px).
     pub black_radius_px: f64,
     /// Transparent bead radius, px (default 10: BeadTracking's radTransBeadPx).
@@ -38,8 +62,9 @@ pub struct BedloadSceneParams {
     /// Range `[min, max]` of rolling speeds along x, drawn at the start of each rolling spell
     /// (default [1, 5] px/frame: between the code's u_rest = 0.561 and u_salt = 9.35).
     pub rolling_speed_px_per_frame: [f64; 2],
-    /// Range of the horizontal speed of a saltation, drawn at its launch (default [10, 20]
-    /// px/frame, about BeadTracking's veloSaltInit = radSearch/2 = 15.5 px/frame).
+    /// Range of the horizontal speed of a saltation, drawn at its launch (default [9, 17]
+    /// px/frame: the real sequence's saltating beads move by a median 13 px/frame, about
+    /// BeadTracking's veloSaltInit = radSearch/2 = 15.5 px/frame).
     pub saltation_speed_px_per_frame: [f64; 2],
     /// Range of the vertical launch speed of each hop, which sets its duration
     /// `round(2v/g)` (default [2, 8] px/frame: hops of 2 to 9 frames, apex up to 19 px).
@@ -85,13 +110,17 @@ impl Default for BedloadSceneParams {
             n_frames: 200,
             n_black: 300,
             n_transparent: 100,
-            bed_layers: 6,
+            bed_layers: 8,
+            creeping_layers: 2,
+            creep_speed_px_per_frame: [0.2, 2.6],
+            creep_switching: [0.12, 0.07],
+            transparent_in_bed: 0.7,
             black_radius_px: 15.0,
             transparent_radius_px: 10.0,
             flow_direction: -1,
             transition_probabilities: [[0.95, 0.05, 0.0], [0.07, 0.92, 0.01], [0.0, 0.09, 0.91]],
             rolling_speed_px_per_frame: [1.0, 5.0],
-            saltation_speed_px_per_frame: [10.0, 20.0],
+            saltation_speed_px_per_frame: [9.0, 17.0],
             launch_speed_px_per_frame: [2.0, 8.0],
             gravity_px_per_frame2: 1.7,
             hop_clearance_px: 0.5,
@@ -110,6 +139,10 @@ const MAX_SIDE: usize = 32_768;
 const MAX_BEADS: usize = 1_000_000;
 /// Largest speed accepted, px/frame.
 const MAX_SPEED: f64 = 1_000.0;
+/// Largest speed of the top creeping layer, px/frame (each layer slips over the one below
+/// by up to `creep_speed_px_per_frame[1]`): well below the 25 px a bead moves in a frame at
+/// most, so that a bead carried by it can still roll.
+const MAX_TOP_CREEP_SPEED: f64 = 10.0;
 
 impl BedloadSceneParams {
     /// Checks every value; the error names the key and its allowed range.
@@ -151,6 +184,7 @@ impl BedloadSceneParams {
             0.0,
             MAX_SPEED,
         )?;
+        self.validate_creep()?;
         let saltation = self.saltation_speed_px_per_frame;
         check_range("saltation_speed_px_per_frame", saltation, 0.0, MAX_SPEED)?;
         check_range(
@@ -203,15 +237,64 @@ impl BedloadSceneParams {
         Ok(())
     }
 
+    fn validate_creep(&self) -> Result<()> {
+        if self.creeping_layers > self.bed_layers {
+            let message = format!("must be ≤ bed_layers ({})", self.bed_layers);
+            return Err(Error::parameter(
+                "creeping_layers",
+                self.creeping_layers,
+                message,
+            ));
+        }
+        let layers = self.creeping_layers.max(1) as f64;
+        check_range(
+            "creep_speed_px_per_frame",
+            self.creep_speed_px_per_frame,
+            0.0,
+            MAX_TOP_CREEP_SPEED / layers,
+        )?;
+        let [start, stop] = self.creep_switching;
+        if !(0.0..=1.0).contains(&start) || !(0.0..=1.0).contains(&stop) {
+            return Err(Error::parameter(
+                "creep_switching",
+                format!("{:?}", self.creep_switching),
+                "both probabilities (start, stop) must be in [0, 1]",
+            ));
+        }
+        check("transparent_in_bed", self.transparent_in_bed, 0.0, 1.0)?;
+        let lodged = lodged_count(self);
+        let room = lodging_site_count(self);
+        if lodged > room {
+            let message = format!(
+                "lodges {lodged} transparent beads in the {room} sites of the top static layer \
+                 and the third from the top; lower it or add layers"
+            );
+            return Err(Error::parameter(
+                "transparent_in_bed",
+                self.transparent_in_bed,
+                message,
+            ));
+        }
+        if lodged > 0 && self.transparent_radius_px > self.black_radius_px {
+            let message = "must be 0 when transparent beads are larger than black ones";
+            return Err(Error::parameter(
+                "transparent_in_bed",
+                self.transparent_in_bed,
+                message,
+            ));
+        }
+        Ok(())
+    }
+
     fn validate_bed(&self) -> Result<()> {
-        let bed = bed_bead_count(self);
+        let bed = bed_black_count(self);
         if self.n_black < bed {
             return Err(Error::parameter(
                 "n_black",
                 self.n_black,
                 format!(
-                    "must be ≥ {bed}, the beads of {} full bed layers across {} px; lower \
-                     `bed_layers` or raise `n_black`",
+                    "must be ≥ {bed}, the black beads of {} full bed layers across {} px; \
+                     lower `bed_layers` or raise `n_black`",
                     self.bed_layers, self.width
                 ),
             ));
@@ -292,16 +375,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn defaults_are_valid_and_leave_42_mobile_black_beads() {
+    fn defaults_are_valid_and_leave_28_mobile_black_beads() {
         let params = BedloadSceneParams::default();
         params.validate().unwrap();
-        assert_eq!(bed_bead_count(&params), 258);
+        // 6 static layers of 43 sites, 70 of them holding a transparent bead, and 2
+        // creeping layers of 42 beads.
+        assert_eq!(lodged_count(&params), 70);
+        assert_eq!(bed_black_count(&params), 6 * 43 - 70 + 2 * 42);
     }
 
     #[test]
     fn bad_values_name_their_key() {
         type Case = (&'static str, fn(&mut BedloadSceneParams));
-        let cases: [Case; 16] = [
+        let cases: [Case; 21] = [
             ("width", |p| p.width = 0),
             ("n_transparent", |p| p.n_transparent = usize::MAX),
             ("n_black", |p| p.n_black = 100),
@@ -322,6 +408,13 @@ mod tests {
                 p.launch_speed_px_per_frame[1] = f64::INFINITY
             }),
             ("gravity_px_per_frame2", |p| p.gravity_px_per_frame2 = 0.0),
+            ("creeping_layers", |p| p.creeping_layers = 9),
+            ("creep_speed_px_per_frame", |p| {
+                p.creep_speed_px_per_frame = [1.0, 6.0]
+            }),
+            ("creep_switching", |p| p.creep_switching[1] = f64::NAN),
+            ("transparent_in_bed", |p| p.transparent_in_bed = 1.5),
+            ("transparent_in_bed", |p| p.n_transparent = 200),
             ("resting_jitter_px", |p| p.resting_jitter_px = 0.2),
             ("bed_disorder_px", |p| p.bed_disorder_px = 5.0),
             ("contact_factors", |p| p.contact_factors[2] = 0.4),

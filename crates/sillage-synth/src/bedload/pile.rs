@@ -9,21 +9,34 @@
 //! beads placed before it at its new x (a bead lies on the beads below it, in the dip
 //! between two where it can). A moving bead advances by steps of 0.5 px and is held back
 //! before a step that would lift it onto a bead not low enough (`min_climb_angle_deg`; the
-//! bed itself never holds a bead back), drop it by more than its diameter, or bring it
-//! within contact of a bead not placed yet (which keeps the previous frame's order of the
-//! beads one above the other, so that staying put is always a valid place). Beads that
-//! carry another are not moved ([`Pile::loads`]), so a resting bead keeps its place to the
-//! last bit. New beads are then dropped from above and slide into a dip, and saltating
-//! beads, placed last, rebound where a bead has moved into their hop (see [`Pile::fly`]). The only exception to the contact distance is a pile reaching the top of the
+//! bed itself never holds a bead back) or bring it within contact of a bead not placed yet
+//! (which keeps the previous frame's order of the beads one above the other, so that
+//! staying put is always a valid place; beads in flight count as not placed yet). Beads
+//! that carry another are not moved ([`Pile::loads`]), so a resting bead keeps its place
+//! to the last bit. New beads are then dropped from above and slide into a dip, and
+//! saltating beads, placed last, rebound where a bead has moved into their hop (see
+//! [`Pile::fly`]).
+//!
+//! Beads move continuously: no bead moves by more than `MAX_STEP_PX` in a frame. A bead
+//! that rolls off a ledge, or whose support moves away or takes off, falls under gravity
+//! over the next frames ([`Pile::free_fall`]); a saltating bead stops where a bead is in
+//! its way. The only exception to the contact distance is a pile reaching the top of the
 //! frame, where centres are kept inside it (not with the default parameters).
 
-use sillage_core::{BLACK_BEAD_CLASS, MotionState, Point2, TRANSPARENT_BEAD_CLASS};
+use sillage_core::{BLACK_BEAD_CLASS, MotionState, Point2, TRANSPARENT_BEAD_CLASS, Vec2};
 
 use super::BedloadSceneParams;
 use super::motion::{Dynamics, Mover};
 
 /// Tolerance of the contact tests, px (rounding only).
 const EPS_PX: f64 = 1e-9;
+
+/// Most pushes that free a bead from the placed beads it overlaps (each from one of them).
+const PUSHES: usize = 4;
+
+/// Tolerance of a flying bead's contacts, px: the bed surface is tabulated within it, and
+/// the settling leaves beads in contact off it by less.
+const SURFACE_TOLERANCE_PX: f64 = 0.1;
 
 /// A bead lying within this of a bead below it (vertically) is held by it, px: a bead in
 /// the dip between two beads, found by steps of 0.5 px, is off the exact contact by less.
@@ -32,14 +45,45 @@ const SUPPORT_TOLERANCE_PX: f64 = 0.5;
 /// The beads a bead lies on (at most two, in a dip between them; none on the bed alone).
 type Supports = [Option<usize>; 2];
 
-/// Largest displacement of a bead in a frame that the settling keeps to where it can, px:
-/// below BeadTracking's search radius (vMax / mByPx / acqFreq = 31 px, MMPF+ §4.3) and
-/// above the fastest saltations' 20 px. A bead that would fall further stays in the air on
-/// the way, and falls on in the next frame.
+/// Largest displacement of a bead in a frame, px (a capped speed): below BeadTracking's
+/// search radius (vMax / mByPx / acqFreq = 31 px, MMPF+ §4.3) and above the fastest
+/// saltations' 20 px. A bead that would fall further stays in the air on the way, and
+/// falls on in the next frame.
 pub(crate) const MAX_STEP_PX: f64 = 25.0;
+
+/// Least elevation of the contact through which a bead lies on another, degrees: a bead
+/// touching others only from the side (a horizontal chain, a saltating bead stopped against
+/// one) falls.
+const MIN_SUPPORT_ANGLE_DEG: f64 = 40.0;
 
 /// Step of a bead's advance or slide along the envelope, px.
 const SLIDE_STEP_PX: f64 = 0.5;
+
+/// A drop of the envelope by more than this between two steps of 0.5 px is a ledge, px (a
+/// slope steeper than 76°): the bead runs off the bead it lay on and falls rather than rolls.
+const LEDGE_PX: f64 = 2.0;
+
+/// Where a bead is placed in a frame.
+#[derive(Debug, Clone, Copy)]
+struct Placement {
+    /// Its centre, px.
+    pos: Point2,
+    /// The placed beads it lies on.
+    supports: Supports,
+    /// Whether it is in the air, falling (not a saltation's flight).
+    airborne: bool,
+}
+
+impl Placement {
+    /// In the air at `pos`, lying on nothing.
+    fn air(pos: Point2) -> Self {
+        Self {
+            pos,
+            supports: [None; 2],
+            airborne: true,
+        }
+    }
+}
 
 /// What a mobile bead does this frame, before the contacts limit it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -178,8 +222,16 @@ impl Pile {
         let y = tops[0]
             .map_or(f64::INFINITY, |t| t.0)
             .min(dynamics.surface.y(x, class));
-        let holds =
-            |t: Option<(f64, usize)>| t.filter(|t| t.0 <= y + SUPPORT_TOLERANCE_PX).map(|t| t.1);
+        // A bead touching another from the side (its centre not below by the least support
+        // angle) is not held by it.
+        let below = |j: usize| {
+            let d = dynamics.params.contact_distance_px(class, movers[j].class);
+            movers[j].anchor.y - y >= d * MIN_SUPPORT_ANGLE_DEG.to_radians().sin()
+        };
+        let holds = |t: Option<(f64, usize)>| {
+            t.filter(|t| t.0 <= y + SUPPORT_TOLERANCE_PX && below(t.1))
+                .map(|t| t.1)
+        };
         (y, tops.map(holds))
     }
 
@@ -197,11 +249,75 @@ impl Pile {
         })
     }
 
-    /// The new place of a bead on the bed that moves by up to `dx` from its place: it
-    /// advances by steps of at most 0.5 px and stops before the first one that would lift it
-    /// above the bed surface onto a bead not low enough (`min_climb_angle_deg`), drop it by
-    /// more than its diameter, or bring it within contact of a bead not placed yet (staying
-    /// put is always free, see the module's comment). Left hanging on the side of a bead, it
+    /// A placed bead that bead `i` at `p` would come closer to than their contact distance.
+    fn overlapped(
+        &self,
+        movers: &[Mover],
+        i: usize,
+        p: Point2,
+        params: &BedloadSceneParams,
+    ) -> Option<usize> {
+        self.near(p.x).find(|&j| {
+            let d = params.contact_distance_px(movers[i].class, movers[j].class);
+            self.status[j] == Status::New && j != i && movers[j].anchor.distance(p) < d - EPS_PX
+        })
+    }
+
+    /// Bead `i` at `place`, pushed straight away from the placed beads it overlaps (one that
+    /// a carried bead rose into) to their contact distance, into the air to fall from there.
+    fn pushed_out(
+        &self,
+        movers: &[Mover],
+        i: usize,
+        place: Placement,
+        params: &BedloadSceneParams,
+    ) -> Placement {
+        let mut pos = place.pos;
+        for _ in 0..PUSHES {
+            let Some(j) = self.overlapped(movers, i, pos, params) else {
+                break;
+            };
+            let d = params.contact_distance_px(movers[i].class, movers[j].class);
+            let away = pos - movers[j].anchor;
+            let norm = away.norm();
+            let unit = if norm > EPS_PX {
+                away * (1.0 / norm)
+            } else {
+                Vec2::new(0.0, -1.0)
+            };
+            pos = movers[j].anchor + unit * d;
+        }
+        if pos == place.pos {
+            place
+        } else {
+            Placement::air(pos)
+        }
+    }
+
+    /// The place of bead `i` on the envelope at `x` ([`Pile::envelope`]).
+    fn on_envelope(
+        &self,
+        movers: &[Mover],
+        i: usize,
+        x: f64,
+        dynamics: &Dynamics<'_>,
+    ) -> Placement {
+        let (y, supports) = self.envelope(movers, i, x, dynamics);
+        Placement {
+            pos: Point2::new(x, y),
+            supports,
+            airborne: false,
+        }
+    }
+
+    /// The new place of a bead on the bed that moves by up to `dx` from its place. With
+    /// nothing under it (its support moved away or took off, or it rolled off a ledge) it
+    /// falls ([`Pile::free_fall`]). Else it advances by steps of at most 0.5 px along the
+    /// envelope and stops before the first one that would lift it above the bed surface onto
+    /// a bead not low enough (`min_climb_angle_deg`; the bed itself never holds a bead back),
+    /// bring it within contact of a bead not placed yet (staying put is always free, see the
+    /// module's comment) or take it farther than `MAX_STEP_PX` from its place; at a ledge
+    /// it rolls off into the air ([`Pile::roll_to`]). Left hanging on the side of a bead, it
     /// then slides down into the dip.
     fn ground_place(
         &self,
@@ -209,71 +325,132 @@ impl Pile {
         i: usize,
         dx: f64,
         dynamics: &Dynamics<'_>,
-    ) -> (Point2, Supports) {
+    ) -> Placement {
         let from = movers[i].anchor;
         let class = movers[i].class;
-        let last_x = dynamics.params.width as f64 - 1.0;
-        let at = |x: f64| {
-            let (y, support) = self.envelope(movers, i, x, dynamics);
-            (Point2::new(x, y), support)
-        };
-        let height = |p: Point2| dynamics.surface.y(p.x, class) - p.y;
-        let sin_climb = dynamics.params.min_climb_angle_deg.to_radians().sin();
-        // Rising above the bed is climbing onto the bead it lies on, which must lie low.
-        let free = |(place, _): &(Point2, Supports), (next, held): &(Point2, Supports)| {
-            let climbs = height(*next) - height(*place) > EPS_PX;
-            let low = held[0].is_some_and(|j| {
-                let d = dynamics.params.contact_distance_px(class, movers[j].class);
-                movers[j].anchor.y - next.y >= d * sin_climb
-            });
-            (!climbs || low) && !self.blocked(movers, i, *next, dynamics.params)
-        };
-        let mut place = at(from.x);
-        if dx == 0.0 {
-            return place;
+        let params = dynamics.params;
+        let last_x = params.width as f64 - 1.0;
+        let start = self.on_envelope(movers, i, from.x, dynamics);
+        let on_bed = dynamics.surface.y(from.x, class) <= start.pos.y + SUPPORT_TOLERANCE_PX;
+        let lying = start.pos.y <= from.y + SUPPORT_TOLERANCE_PX;
+        if !lying || !(on_bed || start.supports[0].is_some()) {
+            return self.free_fall(movers, i, dynamics);
         }
-        // It falls by at most its diameter in a frame: it rolls off a bead onto the bed,
-        // not off a ledge higher, so that it moves by less than BeadTracking's search radius
-        // (31 px for a 5 px roll off a 30 px black bead).
-        let fall = 2.0 * dynamics.params.radius_px(class);
+        if dx == 0.0 {
+            return if self.steady(movers, i, &start, params) {
+                start
+            } else {
+                self.slide(movers, i, start, true, dynamics)
+            };
+        }
+        let height = |p: Point2| dynamics.surface.y(p.x, class) - p.y;
+        let sin_climb = params.min_climb_angle_deg.to_radians().sin();
+        // Rising above the bed is climbing onto the bead it lies on, which must lie low.
+        let free = |place: &Placement, next: &Placement| {
+            let climbs = height(next.pos) - height(place.pos) > EPS_PX;
+            let low = next.supports[0].is_some_and(|j| {
+                let d = params.contact_distance_px(class, movers[j].class);
+                movers[j].anchor.y - next.pos.y >= d * sin_climb
+            });
+            (!climbs || low) && !self.blocked(movers, i, next.pos, params)
+        };
+        let mut place = start;
         let steps = (dx.abs() / SLIDE_STEP_PX).ceil() as usize;
         for k in 1..=steps {
-            let next = at((from.x + dx * k as f64 / steps as f64).clamp(0.0, last_x));
-            if !free(&place, &next) || next.0.y - from.y > fall {
+            let x = (from.x + dx * k as f64 / steps as f64).clamp(0.0, last_x);
+            let next = self.on_envelope(movers, i, x, dynamics);
+            if !free(&place, &next) {
                 break;
             }
-            place = next;
+            let (reached, on) = self.roll_to(movers, i, place, next, params);
+            place = reached;
+            if !on {
+                break;
+            }
         }
-        if !self.steady(movers, i, &place, dynamics.params) {
-            place = self.slide(movers, i, place.0.x, dynamics);
+        if !place.airborne && !self.steady(movers, i, &place, params) {
+            place = self.slide(movers, i, place, true, dynamics);
         }
-        self.within_reach(movers, i, place, dynamics.params)
+        place
     }
 
-    /// `place` if bead `i` gets there from its place by at most `MAX_STEP_PX`, else, for a
-    /// fall, the point above it that far from its place, in the air (it lies on nothing and
-    /// falls on in the next frame), where no bead not placed yet is in the way.
-    fn within_reach(
+    /// Bead `i`, which has got to `place` on the envelope, goes on to `next`, the envelope
+    /// 0.5 px further: the place reached and whether it may go on. It stops at `place` where
+    /// `next` lies farther than `MAX_STEP_PX` from where the bead started the frame (its
+    /// `origin`, a capped speed); where the envelope drops by more than `LEDGE_PX` (a ledge: the bead
+    /// runs off the bead it lay on) it leaves the surface, into the air above `next` at
+    /// `place`'s height, and falls from there in the next frames.
+    fn roll_to(
         &self,
         movers: &[Mover],
         i: usize,
-        place: (Point2, Supports),
+        place: Placement,
+        next: Placement,
         params: &BedloadSceneParams,
-    ) -> (Point2, Supports) {
-        let from = movers[i].anchor;
-        let run = (place.0.x - from.x).abs();
-        if from.distance(place.0) <= MAX_STEP_PX || place.0.y < from.y || run >= MAX_STEP_PX {
-            return place;
+    ) -> (Placement, bool) {
+        if next.pos.distance(movers[i].origin) > MAX_STEP_PX {
+            return (place, false);
         }
-        // Above the envelope at its x, so clear of the beads placed so far.
-        let p = Point2::new(
-            place.0.x,
-            from.y + (MAX_STEP_PX * MAX_STEP_PX - run * run).sqrt(),
-        );
-        if self.blocked(movers, i, p, params) {
-            place
-        } else {
-            (p, [None; 2])
+        if next.pos.y - place.pos.y > LEDGE_PX {
+            let edge = Point2::new(next.pos.x, place.pos.y);
+            let off = if self.blocked(movers, i, edge, params) {
+                place
+            } else {
+                Placement::air(edge)
+            };
+            return (off, false);
+        }
+        (next, true)
+    }
+
+    /// Bead `i`, lying neither on the bed nor on a bead below it, falls straight down: by its
+    /// fall of the last frame plus `gravity_px_per_frame2` (the fall speed grows under the
+    /// buoyancy-reduced gravity), at most `MAX_STEP_PX` (a capped speed), landing on the
+    /// first bead or the bed under it when it gets there. Wedged between beads on its sides,
+    /// it slides down the envelope where it can (lifted first out of a bead that rose into
+    /// it).
+    fn free_fall(&self, movers: &[Mover], i: usize, dynamics: &Dynamics<'_>) -> Placement {
+        let from = movers[i].anchor;
+        let params = dynamics.params;
+        let mut room = dynamics.surface.y(from.x, movers[i].class) - from.y;
+        let mut hit = None;
+        for j in self.near(from.x) {
+            let other = movers[j].anchor;
+            let d = params.contact_distance_px(movers[i].class, movers[j].class);
+            let dx = from.x - other.x;
+            if self.status[j] == Status::Away || j == i || dx.abs() >= d || other.y <= from.y {
+                continue;
+            }
+            let gap = other.y - (d * d - dx * dx).sqrt() - from.y;
+            if gap < room {
+                (room, hit) = (gap, Some(j));
+            }
+        }
+        if room <= SUPPORT_TOLERANCE_PX {
+            // Sunk into the bead under it (the deposit rose under that one): lifted onto it,
+            // or onto the envelope if a placed bead beside it is in the way.
+            let envelope = self.on_envelope(movers, i, from.x, dynamics);
+            let lifted = Point2::new(from.x, from.y + room.min(0.0));
+            let start = if self.overlapped(movers, i, lifted, params).is_some() {
+                envelope
+            } else {
+                Placement {
+                    pos: lifted,
+                    ..envelope
+                }
+            };
+            return self.slide(movers, i, start, true, dynamics);
+        }
+        let fall = (movers[i].fall_px + params.gravity_px_per_frame2).min(MAX_STEP_PX);
+        let pos = Point2::new(from.x, from.y + fall.min(room.max(0.0)));
+        if fall < room {
+            return Placement::air(pos);
+        }
+        let supports = [hit.filter(|&j| self.status[j] == Status::New), None];
+        Placement {
+            pos,
+            supports,
+            airborne: false,
         }
     }
 
@@ -284,62 +461,85 @@ impl Pile {
         &self,
         movers: &[Mover],
         i: usize,
-        (place, held): &(Point2, Supports),
+        place: &Placement,
         params: &BedloadSceneParams,
     ) -> bool {
-        match held {
-            &[Some(j), None] => {
+        match place.supports {
+            [Some(j), None] => {
                 let d = params.contact_distance_px(movers[i].class, movers[j].class);
                 let sin_climb = params.min_climb_angle_deg.to_radians().sin();
-                movers[j].anchor.y - place.y >= d * sin_climb - EPS_PX
+                movers[j].anchor.y - place.pos.y >= d * sin_climb - EPS_PX
             }
             _ => true,
         }
     }
 
-    /// The place of a bead that slides from `x` down the envelope's slope by steps of 0.5 px
+    /// The place of a bead that slides from `start` down the envelope's slope by steps of 0.5 px
     /// to the bottom of the dip, at most one bead diameter away, stopping before a bead not
     /// placed yet: dropped beads pack as a deposit does rather than stick where they first
-    /// touch, and beads left on the side of another slide off.
+    /// touch, and beads left on the side of another slide off. A `moving` bead (not a
+    /// newcomer) moves as [`Pile::roll_to`] lets it.
     fn slide(
         &self,
         movers: &[Mover],
         i: usize,
-        x: f64,
+        start: Placement,
+        moving: bool,
         dynamics: &Dynamics<'_>,
-    ) -> (Point2, Supports) {
-        let last_x = dynamics.params.width as f64 - 1.0;
-        let reach = 2.0 * dynamics.params.radius_px(movers[i].class);
-        let at = |x: f64| {
-            let (y, support) = self.envelope(movers, i, x, dynamics);
-            (Point2::new(x, y), support)
-        };
-        let mut best = at(x);
+    ) -> Placement {
+        let params = dynamics.params;
+        let last_x = params.width as f64 - 1.0;
+        let reach = 2.0 * params.radius_px(movers[i].class);
+        let x = start.pos.x;
+        let mut best = start;
         let (left, right) = (
-            at((x - SLIDE_STEP_PX).max(0.0)),
-            at((x + SLIDE_STEP_PX).min(last_x)),
+            self.on_envelope(movers, i, (x - SLIDE_STEP_PX).max(0.0), dynamics),
+            self.on_envelope(movers, i, (x + SLIDE_STEP_PX).min(last_x), dynamics),
         );
-        let step = if left.0.y > right.0.y {
+        let step = if left.pos.y > right.pos.y {
             -SLIDE_STEP_PX
         } else {
             SLIDE_STEP_PX
         };
-        while (best.0.x - x).abs() < reach {
-            let next = at((best.0.x + step).clamp(0.0, last_x));
-            if next.0.y <= best.0.y || self.blocked(movers, i, next.0, dynamics.params) {
+        while (best.pos.x - x).abs() < reach {
+            let x = (best.pos.x + step).clamp(0.0, last_x);
+            let next = self.on_envelope(movers, i, x, dynamics);
+            if next.pos.y <= best.pos.y || self.blocked(movers, i, next.pos, params) {
                 break;
             }
-            best = next;
+            if !moving {
+                best = next;
+                continue;
+            }
+            let (reached, on) = self.roll_to(movers, i, best, next, params);
+            best = reached;
+            if !on {
+                break;
+            }
         }
         best
     }
 
+    /// Whether bead `i` at `p` is clear of the bed and of every other bead placed or not
+    /// placed yet (a flying bead may pass beside or under a bead, not through it).
+    fn clear(&self, movers: &[Mover], i: usize, p: Point2, dynamics: &Dynamics<'_>) -> bool {
+        let params = dynamics.params;
+        p.y <= dynamics.surface.y(p.x, movers[i].class) + SURFACE_TOLERANCE_PX
+            && !self.near(p.x).any(|j| {
+                let d = params.contact_distance_px(movers[i].class, movers[j].class);
+                self.status[j] != Status::Away
+                    && j != i
+                    && movers[j].anchor.distance(p) < d - SURFACE_TOLERANCE_PX
+            })
+    }
+
     /// The place of a flying bead aimed at `to`, its hop's point for this frame (the frames
-    /// are all that is seen of a flight): `to` where it is clear of the placed beads and the
-    /// bed, or on the envelope below it when the bead `lands` (falling by `MAX_STEP_PX` at
-    /// most in the frame). Where a bead has moved into
-    /// it since the hop was planned (over the pile's top), the flying bead is lifted onto the
-    /// envelope and rebounds from there ([`Pile::stopped`]).
+    /// are all that is seen of a flight), at most `MAX_STEP_PX` from its place (a capped
+    /// speed), and whether it was stopped short. Where a bead has moved into that point since
+    /// the hop was planned (over the pile's top), it stops at the last point clear of the
+    /// beads on the way there, to rebound from it ([`Pile::stopped`]). On the saltation's
+    /// last frame (`lands`) it comes down onto the envelope below that point, or towards it
+    /// by what `MAX_STEP_PX` leaves, to fall on in the next frames.
     fn fly(
         &self,
         movers: &[Mover],
@@ -347,17 +547,55 @@ impl Pile {
         to: Point2,
         lands: bool,
         dynamics: &Dynamics<'_>,
-    ) -> (Point2, Supports, bool) {
-        let (y, held) = self.envelope(movers, i, to.x, dynamics);
-        if y < to.y - EPS_PX {
-            (Point2::new(to.x, y), held, true)
-        } else if lands {
-            let (place, held) =
-                self.within_reach(movers, i, (Point2::new(to.x, y), held), dynamics.params);
-            (place, held, false)
+    ) -> (Placement, bool) {
+        let from = movers[i].anchor;
+        let length = from.distance(to);
+        // What is left of the frame's largest step after the carry of a take-off.
+        let budget = MAX_STEP_PX - movers[i].carried.norm();
+        let capped = length > budget;
+        let end = if capped {
+            from + (to - from) * (budget / length)
         } else {
-            (to, [None; 2], false)
+            to
+        };
+        if !self.clear(movers, i, end, dynamics) {
+            let steps = (from.distance(end) / SLIDE_STEP_PX).ceil() as usize;
+            let reached = (0..steps)
+                .rev()
+                .map(|k| from + (end - from) * (k as f64 / steps as f64))
+                .find(|&p| self.clear(movers, i, p, dynamics))
+                .unwrap_or_else(|| self.lifted(movers, i, budget, dynamics));
+            return (Placement::air(reached), true);
         }
+        if !lands {
+            return (Placement::air(end), capped);
+        }
+        let below = self.on_envelope(movers, i, end.x, dynamics);
+        if below.pos.distance(from) <= budget {
+            return (below, false);
+        }
+        // The lowest point above `below` within reach: `end` is, so the root is real.
+        let run = end.x - from.x;
+        let y = from.y + (budget * budget - run * run).max(0.0).sqrt();
+        let low = Point2::new(end.x, y.max(end.y));
+        let place = if self.clear(movers, i, low, dynamics) {
+            low
+        } else {
+            end
+        };
+        (Placement::air(place), false)
+    }
+
+    /// The lowest point above flying bead `i`, by steps of 0.5 px up to `reach`, where it is
+    /// clear of the others (a bead carried up by the creeping layer rose into it); its place
+    /// if there is none.
+    fn lifted(&self, movers: &[Mover], i: usize, reach: f64, dynamics: &Dynamics<'_>) -> Point2 {
+        let from = movers[i].anchor;
+        let steps = (reach / SLIDE_STEP_PX).floor() as usize;
+        (1..=steps)
+            .map(|k| Point2::new(from.x, from.y - k as f64 * SLIDE_STEP_PX))
+            .find(|&p| self.clear(movers, i, p, dynamics))
+            .unwrap_or(from)
     }
 
     /// Whether flying bead `i` was stopped short of its hop's point in the last settling.
@@ -373,12 +611,14 @@ impl Pile {
         proposals: &[Proposal],
         dynamics: &Dynamics<'_>,
     ) {
+        let params = dynamics.params;
         for cell in &mut self.cells {
             cell.clear();
         }
         for (i, proposal) in proposals.iter().enumerate() {
             self.status[i] = Status::Away;
-            if matches!(proposal, Proposal::Ground { .. }) {
+            // Beads in flight are in the way of the others until they are placed.
+            if !matches!(proposal, Proposal::Drop { .. }) {
                 self.status[i] = Status::Old;
                 self.insert(i, movers[i].anchor.x);
             }
@@ -405,32 +645,48 @@ impl Pile {
         });
         for &i in &order {
             self.stopped[i] = false;
-            let (place, support) = match proposals[i] {
+            let from = movers[i].anchor;
+            let place = match proposals[i] {
                 Proposal::Ground { dx } => self.ground_place(movers, i, dx, dynamics),
                 Proposal::Drop { x } => {
                     let steps = ((x[1] - x[0]).abs() / SLIDE_STEP_PX).ceil() as usize;
+                    // The lowest point clear of the beads in flight.
                     let lowest = (0..=steps)
                         .map(|k| x[0] + (x[1] - x[0]) * k as f64 / steps.max(1) as f64)
                         .map(|x| (self.envelope(movers, i, x, dynamics).0, x))
+                        .filter(|&(y, x)| !self.blocked(movers, i, Point2::new(x, y), params))
                         .fold(
                             (f64::NEG_INFINITY, x[0]),
                             |a, b| if b.0 > a.0 { b } else { a },
                         );
-                    self.slide(movers, i, lowest.1, dynamics)
+                    let start = self.on_envelope(movers, i, lowest.1, dynamics);
+                    self.slide(movers, i, start, false, dynamics)
                 }
                 Proposal::Air { to, lands } => {
-                    let (place, support, stopped) = self.fly(movers, i, to, lands, dynamics);
+                    let (place, stopped) = self.fly(movers, i, to, lands, dynamics);
                     self.stopped[i] = stopped;
-                    (place, support)
+                    place
                 }
+            };
+            // Flying beads were kept clear of every bead by `fly`.
+            let place = match proposals[i] {
+                Proposal::Air { .. } => place,
+                _ => self.pushed_out(movers, i, place, params),
             };
             if self.status[i] == Status::Old {
                 self.remove(i);
             }
-            movers[i].anchor = Point2::new(place.x, place.y.max(0.0));
+            movers[i].anchor = Point2::new(place.pos.x, place.pos.y.max(0.0));
+            // A bead left in the air falls on in the next frame at the speed it had.
+            movers[i].fall_px = if place.airborne {
+                (movers[i].anchor.y - from.y).max(0.0)
+            } else {
+                0.0
+            };
+            movers[i].grounded = !place.airborne;
             self.status[i] = Status::New;
-            self.supports[i] = support;
-            self.insert(i, place.x);
+            self.supports[i] = place.supports;
+            self.insert(i, place.pos.x);
         }
         self.order = order;
     }
