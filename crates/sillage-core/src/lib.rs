@@ -23,6 +23,7 @@
 mod calibration;
 mod error;
 mod geometry;
+pub mod homography;
 mod image;
 mod observation;
 mod rng;
@@ -31,6 +32,7 @@ mod roles;
 pub use calibration::Calibration;
 pub use error::{Error, Result};
 pub use geometry::{Point2, Vec2};
+pub use homography::Homography;
 pub use image::{GrayImage, Image, RgbImage};
 pub use observation::{
     BLACK_BEAD_CLASS, Detection, FrameIndex, MotionState, ObjectClass, TRANSPARENT_BEAD_CLASS,

@@ -68,6 +68,7 @@ pub use linalg::{Gaussian, Matrix, Vector};
 pub use motion::MotionModel;
 pub use motion::bedload::{BedloadMode, BedloadModel};
 pub use motion::kinematic::{KinematicModel, Switching};
+pub use motion::prior::{MotionPrior, MotionPriorParams};
 pub use noise::{Gauss2, Noise2};
 pub use normal::Normals;
 pub use params::{

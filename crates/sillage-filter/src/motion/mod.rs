@@ -3,12 +3,15 @@
 //! of the MMPF+ paper).
 //!
 //! - [`bedload`]: the four bead motions of Eq. (3) with jump-Markov switching (§3.5.1, §4.3);
-//! - [`kinematic`]: constant position / velocity / acceleration, alone or switched.
+//! - [`kinematic`]: constant position / velocity / acceleration, alone or switched;
+//! - [`prior`]: the learned motion prior (MP) of the pedestrian IMM particle filter (§5.1 of
+//!   Madrigal & Hayet): per-cell direction probabilities and mean velocities.
 //!
 //! Positions are in px and velocities in px/frame, so the Δt of Eq. (3) is one frame.
 
 pub mod bedload;
 pub mod kinematic;
+pub mod prior;
 
 use sillage_core::RngStream;
 
