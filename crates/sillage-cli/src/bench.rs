@@ -63,6 +63,7 @@ fn vortex_frames(
             index: f.index,
             path: PathBuf::from(format!("synthetic:{}", f.index)),
             image: f.image,
+            colour: None,
         })
     }))
 }

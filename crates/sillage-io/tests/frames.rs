@@ -232,6 +232,7 @@ fn frames_of_different_sizes_are_refused_naming_both() {
     let text = err.to_string();
     assert!(matches!(err, Error::Frame { frame: 1, .. }));
     assert!(text.contains("7×6") && text.contains("8×6"), "{text}");
+    assert!(text.contains("a2.png"), "the error names the file: {text}");
 }
 
 #[test]
@@ -320,4 +321,114 @@ fn damaged_ccitt_tiff_names_the_file_and_the_row() {
         error.contains("mask.tif") && error.contains("row 1"),
         "{error}"
     );
+}
+
+fn colour_options() -> FrameOptions {
+    FrameOptions {
+        colour: true,
+        ..FrameOptions::default()
+    }
+}
+
+/// A 5×3 RGB picture with every pixel different, so a swapped channel or row shows.
+fn rgb_pattern() -> image::RgbImage {
+    image::RgbImage::from_fn(5, 3, |x, y| {
+        image::Rgb([
+            (x * 50 + y) as u8,
+            (255 - y * 80 - x) as u8,
+            (x * y * 17 + 3) as u8,
+        ])
+    })
+}
+
+#[test]
+fn colour_of_an_rgb_png_is_read_back_exactly_and_grey_is_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("c.png");
+    let picture = rgb_pattern();
+    picture.save(&path).unwrap();
+    let input = path.to_str().unwrap();
+    let colour: Vec<_> = open_frames(input, &colour_options())
+        .unwrap()
+        .map(Result::unwrap)
+        .collect();
+    let grey: Vec<_> = open_frames(input, &FrameOptions::default())
+        .unwrap()
+        .map(Result::unwrap)
+        .collect();
+    assert_eq!(colour.len(), 1);
+    let rgb = colour[0].colour.as_ref().expect("colour was requested");
+    assert_eq!(rgb.dimensions(), (5, 3));
+    for (x, y, p) in picture.enumerate_pixels() {
+        assert_eq!(rgb.get(x as usize, y as usize), p.0, "pixel ({x}, {y})");
+    }
+    assert!(grey[0].colour.is_none(), "colour only when requested");
+    assert_eq!(
+        colour[0].image, grey[0].image,
+        "grey does not depend on colour"
+    );
+    let [r, g, b] = picture.get_pixel(3, 2).0.map(|v| f32::from(v) / 255.0);
+    let luma = 0.299 * r + 0.587 * g + 0.114 * b;
+    assert!((grey[0].image.get(3, 2) - luma).abs() < 1e-6);
+}
+
+#[test]
+fn colour_of_grey_and_16bit_frames_is_replicated_and_rounded_to_8_bits() {
+    let dir = tempfile::tempdir().unwrap();
+    gray8(&dir.path().join("1.png"), 4, 2, 77);
+    image::ImageBuffer::<image::Rgb<u16>, _>::from_pixel(4, 2, image::Rgb([65535u16, 257, 300]))
+        .save(dir.path().join("2.png"))
+        .unwrap();
+    let frames: Vec<_> = open_frames(dir.path().to_str().unwrap(), &colour_options())
+        .unwrap()
+        .map(Result::unwrap)
+        .collect();
+    assert_eq!(frames[0].colour.as_ref().unwrap().get(3, 1), [77, 77, 77]);
+    // 300 / 257 = 1.17 rounds to 1.
+    assert_eq!(frames[1].colour.as_ref().unwrap().get(0, 0), [255, 1, 1]);
+}
+
+#[test]
+fn tiff_stack_pages_carry_their_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stack.tif");
+    tiff16_pages(&path, 3, 2, &[0, 32768, 65535]);
+    let source = open_frames(path.to_str().unwrap(), &colour_options()).unwrap();
+    let colours: Vec<[u8; 3]> = source
+        .map(|f| f.unwrap().colour.unwrap().get(2, 1))
+        .collect();
+    assert_eq!(colours, [[0; 3], [128; 3], [255; 3]]);
+}
+
+#[test]
+fn stack_pages_of_different_sizes_are_refused_naming_the_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mixed.tif");
+    let file = std::fs::File::create(&path).unwrap();
+    let mut encoder = tiff::encoder::TiffEncoder::new(file).unwrap();
+    encoder
+        .write_image::<tiff::encoder::colortype::Gray8>(4, 3, &[1; 12])
+        .unwrap();
+    encoder
+        .write_image::<tiff::encoder::colortype::Gray8>(3, 3, &[1; 9])
+        .unwrap();
+    drop(encoder);
+    let mut source = open_frames(path.to_str().unwrap(), &colour_options()).unwrap();
+    assert!(source.next().unwrap().is_ok());
+    match source.next().unwrap().unwrap_err() {
+        Error::Frame {
+            path: named,
+            frame,
+            message,
+        } => {
+            assert_eq!(named, path);
+            assert_eq!(frame, 1);
+            assert!(
+                message.contains("3×3") && message.contains("4×3"),
+                "{message}"
+            );
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    assert!(source.next().is_none());
 }

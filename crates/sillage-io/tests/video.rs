@@ -107,3 +107,45 @@ fn missing_ffprobe_says_how_to_install_it() {
         other => panic!("unexpected {other:?}"),
     }
 }
+
+#[test]
+fn colour_video_gives_rgb_frames_and_their_rec601_grey() {
+    if !ffmpeg_available() {
+        eprintln!("note: ffmpeg/ffprobe not installed; skipping the colour video test");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("colour.mkv");
+    // Lossless RGB (ffv1 in bgr0), so the frames come back exactly as generated.
+    let status = Command::new("ffmpeg")
+        .args(["-v", "error", "-y", "-f", "lavfi", "-i"])
+        .arg("testsrc=size=64x48:rate=10")
+        .args(["-frames:v", "3", "-pix_fmt", "bgr0", "-c:v", "ffv1"])
+        .arg(&path)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let options = FrameOptions {
+        colour: true,
+        ..FrameOptions::default()
+    };
+    let frames: Vec<_> = open_frames(path.to_str().unwrap(), &options)
+        .unwrap()
+        .map(Result::unwrap)
+        .collect();
+    assert_eq!(frames.len(), 3);
+    let rgb = frames[0].colour.as_ref().expect("colour was requested");
+    assert_eq!(rgb.dimensions(), (64, 48));
+    // testsrc draws saturated colour bars: some pixel has distinct channels.
+    assert!(rgb.as_slice().iter().any(|p| p[0] != p[1] || p[1] != p[2]));
+    for (&p, &grey) in rgb.as_slice().iter().zip(frames[0].image.as_slice()) {
+        let [r, g, b] = p.map(|v| f32::from(v) / 255.0);
+        assert!((grey - (0.299 * r + 0.587 * g + 0.114 * b)).abs() < 1e-6);
+    }
+    let grey_only = open_frames(path.to_str().unwrap(), &FrameOptions::default())
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap();
+    assert!(grey_only.colour.is_none());
+}

@@ -31,6 +31,7 @@ fn drifting_frames(n: usize) -> Vec<Frame> {
                     i as u64,
                 )
                 .unwrap(),
+                colour: None,
             }
         })
         .collect()

@@ -1,14 +1,19 @@
 //! Decoding one image file (PNG, JPEG, single-page TIFF) or one TIFF page into a [`GrayImage`]
-//! (1-bit TIFFs with CCITT modified Huffman compression through [`super::ccitt`]).
+//! (1-bit TIFFs with CCITT modified Huffman compression through [`super::ccitt`]), and on
+//! request into an 8-bit [`RgbImage`] as well.
 //!
 //! Grey levels are normalised to `[0, 1]`: 8-bit values are divided by 255, 16-bit by 65535;
 //! 32/64-bit float grey is kept as is. Colour is converted to grey with the Rec. 601 luma
 //! weights `0.299 R + 0.587 G + 0.114 B` (the weights OpenCV's `BGR2GRAY` uses, so frames
 //! match TracTrac's); an alpha channel is dropped.
+//!
+//! The colour picture keeps 8-bit samples as they are, rounds 16-bit ones to 8 bits
+//! (`v / 257`), clamps float ones to `[0, 1]` before scaling by 255, and replicates grey
+//! into the three channels.
 
 use std::path::Path;
 
-use sillage_core::{GrayImage, Result};
+use sillage_core::{GrayImage, Result, RgbImage};
 use tiff::ColorType;
 use tiff::decoder::{Decoder, DecodingResult};
 
@@ -19,6 +24,15 @@ const LUMA_601: [f32; 3] = [0.299, 0.587, 0.114];
 
 /// Why a frame could not be decoded; the caller adds the file and the frame index.
 pub(crate) type DecodeResult<T> = std::result::Result<T, String>;
+
+/// One decoded picture: its grey levels, and its colour when it was asked for.
+#[derive(Debug)]
+pub(crate) struct Decoded {
+    /// Grey levels (Rec. 601 luma of colour pictures).
+    pub(crate) grey: GrayImage,
+    /// 8-bit colour (grey pictures replicated), `Some` only when requested.
+    pub(crate) colour: Option<RgbImage>,
+}
 
 /// True when `path` has a TIFF extension (`.tif`, `.tiff`, any case).
 pub(crate) fn is_tiff(path: &Path) -> bool {
@@ -32,12 +46,13 @@ pub(crate) fn has_extension(path: &Path, extensions: &[&str]) -> bool {
         .is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
 }
 
-/// Decodes the image file at `path` (for a TIFF, its first page).
-pub(crate) fn decode_file(path: &Path) -> DecodeResult<GrayImage> {
+/// Decodes the image file at `path` (for a TIFF, its first page), with its colour when
+/// `colour` is true.
+pub(crate) fn decode_file(path: &Path, colour: bool) -> DecodeResult<Decoded> {
     if is_tiff(path) {
         let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
         let mut decoder = Decoder::new(std::io::BufReader::new(file)).map_err(|e| e.to_string())?;
-        decode_tiff_page(&mut decoder)
+        decode_tiff_page(&mut decoder, colour)
     } else {
         let image = image::ImageReader::open(path)
             .map_err(|e| e.to_string())?
@@ -45,7 +60,7 @@ pub(crate) fn decode_file(path: &Path) -> DecodeResult<GrayImage> {
             .map_err(|e| e.to_string())?
             .decode()
             .map_err(|e| e.to_string())?;
-        dynamic_to_gray(image)
+        decode_dynamic(image, colour)
     }
 }
 
@@ -67,60 +82,122 @@ pub(crate) fn file_dimensions(path: &Path) -> DecodeResult<(usize, usize)> {
     Ok((w as usize, h as usize))
 }
 
-/// Decodes the current page of a TIFF decoder.
+/// Decodes the current page of a TIFF decoder, with its colour when `colour` is true.
 pub(crate) fn decode_tiff_page<R: std::io::Read + std::io::Seek>(
     decoder: &mut Decoder<R>,
-) -> DecodeResult<GrayImage> {
+    colour: bool,
+) -> DecodeResult<Decoded> {
     let compression = decoder
         .find_tag_unsigned::<u16>(tiff::tags::Tag::Compression)
         .map_err(|e| e.to_string())?;
     if compression == Some(ccitt::MODIFIED_HUFFMAN) {
-        return ccitt::decode_modified_huffman(decoder);
+        let grey = ccitt::decode_modified_huffman(decoder)?;
+        let colour = if colour {
+            Some(grey_to_rgb(&grey)?)
+        } else {
+            None
+        };
+        return Ok(Decoded { grey, colour });
     }
     let (w, h) = decoder.dimensions().map_err(|e| e.to_string())?;
-    let colour = decoder.colortype().map_err(|e| e.to_string())?;
-    let channels = match colour {
+    let colour_type = decoder.colortype().map_err(|e| e.to_string())?;
+    let channels = match colour_type {
         ColorType::Gray(_) => 1,
         ColorType::GrayA(_) => 2,
         ColorType::RGB(_) => 3,
         ColorType::RGBA(_) => 4,
         other => return Err(unsupported(&format!("TIFF colour type {other:?}"))),
     };
-    let pixels = match decoder.read_image().map_err(|e| e.to_string())? {
-        DecodingResult::U8(v) => to_luma(&v, channels, |p| f32::from(p) / 255.0),
-        DecodingResult::U16(v) => to_luma(&v, channels, |p| f32::from(p) / 65535.0),
-        DecodingResult::F32(v) => to_luma(&v, channels, |p| p),
-        DecodingResult::F64(v) => to_luma(&v, channels, |p| p as f32),
-        _ => return Err(unsupported(&format!("TIFF sample type of {colour:?}"))),
-    };
-    GrayImage::from_vec(w as usize, h as usize, pixels).map_err(|e| e.to_string())
+    let (w, h) = (w as usize, h as usize);
+    match decoder.read_image().map_err(|e| e.to_string())? {
+        DecodingResult::U8(v) => decoded(w, h, &v, channels, colour, u8_unit, |p| p),
+        DecodingResult::U16(v) => decoded(w, h, &v, channels, colour, u16_unit, u16_to_u8),
+        DecodingResult::F32(v) => decoded(w, h, &v, channels, colour, |p| p, f32_to_u8),
+        DecodingResult::F64(v) => decoded(
+            w,
+            h,
+            &v,
+            channels,
+            colour,
+            |p| p as f32,
+            |p| f32_to_u8(p as f32),
+        ),
+        _ => Err(unsupported(&format!("TIFF sample type of {colour_type:?}"))),
+    }
 }
 
-/// Converts a decoded PNG/JPEG (or any `image` crate picture) to grey.
-fn dynamic_to_gray(image: image::DynamicImage) -> DecodeResult<GrayImage> {
+/// Converts a decoded PNG/JPEG (or any `image` crate picture) to grey, and to colour when
+/// `colour` is true.
+fn decode_dynamic(image: image::DynamicImage, colour: bool) -> DecodeResult<Decoded> {
     use image::DynamicImage as D;
     let (w, h) = (image.width() as usize, image.height() as usize);
-    let u8_scale = |p: u8| f32::from(p) / 255.0;
-    let u16_scale = |p: u16| f32::from(p) / 65535.0;
-    let pixels = match image {
-        D::ImageLuma8(b) => to_luma(b.as_raw(), 1, u8_scale),
-        D::ImageLumaA8(b) => to_luma(b.as_raw(), 2, u8_scale),
-        D::ImageRgb8(b) => to_luma(b.as_raw(), 3, u8_scale),
-        D::ImageRgba8(b) => to_luma(b.as_raw(), 4, u8_scale),
-        D::ImageLuma16(b) => to_luma(b.as_raw(), 1, u16_scale),
-        D::ImageLumaA16(b) => to_luma(b.as_raw(), 2, u16_scale),
-        D::ImageRgb16(b) => to_luma(b.as_raw(), 3, u16_scale),
-        D::ImageRgba16(b) => to_luma(b.as_raw(), 4, u16_scale),
-        D::ImageRgb32F(b) => to_luma(b.as_raw(), 3, |p| p),
-        D::ImageRgba32F(b) => to_luma(b.as_raw(), 4, |p| p),
-        other => return Err(unsupported(&format!("{:?}", other.color()))),
+    let c = colour;
+    match image {
+        D::ImageLuma8(b) => decoded(w, h, b.as_raw(), 1, c, u8_unit, |p| p),
+        D::ImageLumaA8(b) => decoded(w, h, b.as_raw(), 2, c, u8_unit, |p| p),
+        D::ImageRgb8(b) => decoded(w, h, b.as_raw(), 3, c, u8_unit, |p| p),
+        D::ImageRgba8(b) => decoded(w, h, b.as_raw(), 4, c, u8_unit, |p| p),
+        D::ImageLuma16(b) => decoded(w, h, b.as_raw(), 1, c, u16_unit, u16_to_u8),
+        D::ImageLumaA16(b) => decoded(w, h, b.as_raw(), 2, c, u16_unit, u16_to_u8),
+        D::ImageRgb16(b) => decoded(w, h, b.as_raw(), 3, c, u16_unit, u16_to_u8),
+        D::ImageRgba16(b) => decoded(w, h, b.as_raw(), 4, c, u16_unit, u16_to_u8),
+        D::ImageRgb32F(b) => decoded(w, h, b.as_raw(), 3, c, |p| p, f32_to_u8),
+        D::ImageRgba32F(b) => decoded(w, h, b.as_raw(), 4, c, |p| p, f32_to_u8),
+        other => Err(unsupported(&format!("{:?}", other.color()))),
+    }
+}
+
+/// An 8-bit sample in `[0, 1]`.
+pub(crate) fn u8_unit(p: u8) -> f32 {
+    f32::from(p) / 255.0
+}
+
+/// A 16-bit sample in `[0, 1]`.
+fn u16_unit(p: u16) -> f32 {
+    f32::from(p) / 65535.0
+}
+
+/// A 16-bit sample rounded to 8 bits (`65535 / 255 = 257`).
+fn u16_to_u8(p: u16) -> u8 {
+    ((u32::from(p) + 128) / 257) as u8
+}
+
+/// A float sample in `[0, 1]` (clamped) scaled to 8 bits, rounded.
+fn f32_to_u8(p: f32) -> u8 {
+    (p.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// Builds a [`Decoded`] from interleaved samples with `channels` per pixel (1 grey, 2 grey +
+/// alpha, 3 RGB, 4 RGBA): `unit` maps a sample to `[0, 1]` for grey, `byte` to 8 bits for
+/// colour.
+fn decoded<T: Copy>(
+    width: usize,
+    height: usize,
+    samples: &[T],
+    channels: usize,
+    colour: bool,
+    unit: impl Fn(T) -> f32,
+    byte: impl Fn(T) -> u8,
+) -> DecodeResult<Decoded> {
+    let grey = GrayImage::from_vec(width, height, to_luma(samples, channels, unit))
+        .map_err(|e| e.to_string())?;
+    let colour = if colour {
+        let pixels = to_rgb8(samples, channels, byte);
+        Some(RgbImage::from_vec(width, height, pixels).map_err(|e| e.to_string())?)
+    } else {
+        None
     };
-    GrayImage::from_vec(w, h, pixels).map_err(|e| e.to_string())
+    Ok(Decoded { grey, colour })
 }
 
 /// Grey values from interleaved samples with `channels` per pixel: 1 grey, 2 grey + alpha,
-/// 3 RGB, 4 RGBA. `scale` maps a sample to `[0, 1]`.
-fn to_luma<T: Copy>(samples: &[T], channels: usize, scale: impl Fn(T) -> f32) -> Vec<f32> {
+/// 3 RGB, 4 RGBA. `scale` maps a sample to `[0, 1]`. The one place the Rec. 601 luma is
+/// computed (video frames decoded as RGB come through here too).
+pub(crate) fn to_luma<T: Copy>(
+    samples: &[T],
+    channels: usize,
+    scale: impl Fn(T) -> f32,
+) -> Vec<f32> {
     match channels {
         1 => samples.iter().map(|&p| scale(p)).collect(),
         2 => samples.chunks_exact(2).map(|p| scale(p[0])).collect(),
@@ -131,6 +208,27 @@ fn to_luma<T: Copy>(samples: &[T], channels: usize, scale: impl Fn(T) -> f32) ->
             })
             .collect(),
     }
+}
+
+/// 8-bit RGB pixels from interleaved samples laid out as in [`to_luma`]; grey is replicated
+/// into the three channels and alpha dropped. `byte` maps a sample to 8 bits.
+fn to_rgb8<T: Copy>(samples: &[T], channels: usize, byte: impl Fn(T) -> u8) -> Vec<[u8; 3]> {
+    match channels {
+        1 | 2 => samples
+            .chunks_exact(channels)
+            .map(|p| [byte(p[0]); 3])
+            .collect(),
+        _ => samples
+            .chunks_exact(channels)
+            .map(|p| [byte(p[0]), byte(p[1]), byte(p[2])])
+            .collect(),
+    }
+}
+
+/// A grey picture in `[0, 1]` as 8-bit colour, each level replicated into the three channels.
+fn grey_to_rgb(grey: &GrayImage) -> DecodeResult<RgbImage> {
+    let pixels = grey.as_slice().iter().map(|&v| [f32_to_u8(v); 3]).collect();
+    RgbImage::from_vec(grey.width(), grey.height(), pixels).map_err(|e| e.to_string())
 }
 
 fn unsupported(what: &str) -> String {
@@ -144,13 +242,17 @@ fn unsupported(what: &str) -> String {
 pub fn read_image(path: impl AsRef<Path>) -> Result<GrayImage> {
     let path = path.as_ref();
     super::input::check_exists(path)?;
-    decode_file(path).map_err(|message| {
-        sillage_core::Error::format(
-            path,
-            None,
-            format!("cannot decode: {message}; check that it is a valid PNG, JPEG or TIFF image"),
-        )
-    })
+    decode_file(path, false)
+        .map(|decoded| decoded.grey)
+        .map_err(|message| {
+            sillage_core::Error::format(
+                path,
+                None,
+                format!(
+                    "cannot decode: {message}; check that it is a valid PNG, JPEG or TIFF image"
+                ),
+            )
+        })
 }
 
 #[cfg(test)]

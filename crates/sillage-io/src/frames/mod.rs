@@ -13,11 +13,12 @@ use std::path::{Path, PathBuf};
 use std::thread::JoinHandle;
 
 use crossbeam_channel::{Receiver, Sender};
-use sillage_core::{Error, FrameIndex, GrayImage, Result};
+use sillage_core::{Error, FrameIndex, GrayImage, Result, RgbImage};
 
 pub use decode::read_image;
 pub use encode::{write_png_rgb, write_png16, write_text};
 
+use decode::Decoded;
 use input::InputKind;
 use video::{FfmpegDecoder, VideoInfo};
 
@@ -32,6 +33,9 @@ pub struct FrameOptions {
     pub ffmpeg: PathBuf,
     /// The `ffprobe` program used to read a video's size.
     pub ffprobe: PathBuf,
+    /// Also decode each frame's 8-bit colour into [`Frame::colour`] (for colour-histogram
+    /// observation models); default false, so grey-only pipelines pay nothing for it.
+    pub colour: bool,
 }
 
 impl Default for FrameOptions {
@@ -41,6 +45,7 @@ impl Default for FrameOptions {
             max_frames: None,
             ffmpeg: "ffmpeg".into(),
             ffprobe: "ffprobe".into(),
+            colour: false,
         }
     }
 }
@@ -54,6 +59,9 @@ pub struct Frame {
     pub path: PathBuf,
     /// Grey levels in `[0, 1]`.
     pub image: GrayImage,
+    /// 8-bit colour (16-bit samples rounded to 8 bits, grey replicated into the three
+    /// channels), present when [`FrameOptions::colour`] was set.
+    pub colour: Option<RgbImage>,
 }
 
 /// A sequence of frames, decoded ahead on a background thread.
@@ -79,10 +87,14 @@ pub struct FrameSource {
 /// `0.299 R + 0.587 G + 0.114 B` (as OpenCV's, so frames match TracTrac's) and alpha is
 /// dropped. In a folder or glob every file is one frame (a TIFF's first page).
 ///
+/// With [`FrameOptions::colour`] each frame also carries its 8-bit colour; a video is then
+/// decoded as RGB and its grey derived with the same Rec. 601 weights.
+///
 /// The first frame's size is read here, so a missing or unreadable input fails now rather
 /// than on the first iteration.
 pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
     let limit = |n: usize| options.max_frames.map_or(n, |m| m.min(n));
+    let colour = options.colour;
     let (sender, receiver) = crossbeam_channel::bounded(options.read_ahead);
     let (len, dimensions, paths, worker) = match input::resolve(input)? {
         InputKind::Files(mut files) => {
@@ -93,7 +105,7 @@ pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
             files.truncate(len);
             let worker_files = files.clone();
             let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
-                read_files(&worker_files, emitter);
+                read_files(&worker_files, colour, emitter);
             })?;
             (Some(len), dimensions, files, worker)
         }
@@ -102,7 +114,7 @@ pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
                 .map_err(|message| Error::frame(&path, 0, decode_failure(&message)))?;
             let stack = path.clone();
             let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
-                tiff_stack::read_pages(&stack, |page| match page {
+                tiff_stack::read_pages(&stack, colour, |page| match page {
                     Ok(image) => emitter.frame(&stack, image),
                     Err(message) => emitter.fail(&stack, decode_failure(&message)),
                 });
@@ -111,7 +123,7 @@ pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
         }
         InputKind::Video(path) => {
             let info = video::probe(&options.ffprobe, &path)?;
-            let decoder = FfmpegDecoder::spawn(&options.ffmpeg, &path)?;
+            let decoder = FfmpegDecoder::spawn(&options.ffmpeg, &path, colour)?;
             let video = path.clone();
             let dimensions = (info.width, info.height);
             let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
@@ -134,9 +146,9 @@ fn decode_failure(message: &str) -> String {
     format!("cannot decode: {message}; remove or replace the file")
 }
 
-fn read_files(files: &[PathBuf], emitter: &mut Emitter) {
+fn read_files(files: &[PathBuf], colour: bool, emitter: &mut Emitter) {
     for path in files {
-        let keep_going = match decode::decode_file(path) {
+        let keep_going = match decode::decode_file(path, colour) {
             Ok(image) => emitter.frame(path, image),
             Err(message) => emitter.fail(path, decode_failure(&message)),
         };
@@ -191,7 +203,11 @@ struct Emitter {
 
 impl Emitter {
     /// Sends one decoded frame; `false` means stop reading.
-    fn frame(&mut self, path: &Path, image: GrayImage) -> bool {
+    fn frame(&mut self, path: &Path, decoded: Decoded) -> bool {
+        let Decoded {
+            grey: image,
+            colour,
+        } = decoded;
         let index = self.next_index;
         if self.max_frames.is_some_and(|m| index >= m as FrameIndex) {
             return false;
@@ -211,6 +227,7 @@ impl Emitter {
             index,
             path: path.to_path_buf(),
             image,
+            colour,
         };
         self.next_index += 1;
         let below_limit = self

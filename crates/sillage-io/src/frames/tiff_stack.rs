@@ -5,10 +5,10 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
-use sillage_core::{Error, GrayImage, Result};
+use sillage_core::{Error, Result};
 use tiff::decoder::Decoder;
 
-use super::decode::{DecodeResult, decode_tiff_page};
+use super::decode::{DecodeResult, Decoded, decode_tiff_page};
 
 fn open(path: &Path) -> Result<Decoder<BufReader<File>>> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
@@ -39,9 +39,13 @@ pub(crate) fn count_pages(path: &Path) -> Result<usize> {
     Ok(pages)
 }
 
-/// Decodes the pages of the stack at `path` in order, handing each to `emit` until it
-/// returns `false` or the pages run out.
-pub(crate) fn read_pages(path: &Path, mut emit: impl FnMut(DecodeResult<GrayImage>) -> bool) {
+/// Decodes the pages of the stack at `path` in order (with their colour when `colour` is
+/// true), handing each to `emit` until it returns `false` or the pages run out.
+pub(crate) fn read_pages(
+    path: &Path,
+    colour: bool,
+    mut emit: impl FnMut(DecodeResult<Decoded>) -> bool,
+) {
     let mut decoder = match File::open(path)
         .map_err(|e| e.to_string())
         .and_then(|f| Decoder::new(BufReader::new(f)).map_err(|e| e.to_string()))
@@ -53,7 +57,7 @@ pub(crate) fn read_pages(path: &Path, mut emit: impl FnMut(DecodeResult<GrayImag
         }
     };
     loop {
-        if !emit(decode_tiff_page(&mut decoder)) || !decoder.more_images() {
+        if !emit(decode_tiff_page(&mut decoder, colour)) || !decoder.more_images() {
             return;
         }
         if let Err(e) = decoder.next_image() {

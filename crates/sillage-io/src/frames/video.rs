@@ -1,13 +1,17 @@
 //! Video files read through the `ffmpeg` program as a subprocess (no FFmpeg library is
 //! linked, so the default build stays pure Rust). Frames are decoded as 16-bit grey
 //! (`-pix_fmt gray16le`), so 8-bit and 16-bit videos both land in `[0, 1]`; colour video
-//! is converted to grey by FFmpeg's scaler.
+//! is converted to grey by FFmpeg's scaler. When colour is requested they are decoded as
+//! 8-bit RGB (`-pix_fmt rgb24`) instead, and grey is derived from it with the Rec. 601 luma
+//! of [`super::decode`], as for colour image files.
 
 use std::io::Read;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 
-use sillage_core::{Error, GrayImage, Result};
+use sillage_core::{Error, GrayImage, Result, RgbImage};
+
+use super::decode::{DecodeResult, Decoded, to_luma, u8_unit};
 
 /// Size and (when the container records it) frame count of a video's first video stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -70,25 +74,28 @@ pub(crate) fn probe(ffprobe: &Path, video: &Path) -> Result<VideoInfo> {
     }
 }
 
-/// A running `ffmpeg` that writes raw 16-bit grey frames on its stdout.
+/// A running `ffmpeg` that writes raw frames on its stdout: 16-bit grey, or 8-bit RGB when
+/// colour was requested.
 #[derive(Debug)]
 pub(crate) struct FfmpegDecoder {
     child: Child,
+    colour: bool,
 }
 
 impl FfmpegDecoder {
-    /// Starts `ffmpeg` on `video`.
-    pub(crate) fn spawn(ffmpeg: &Path, video: &Path) -> Result<Self> {
+    /// Starts `ffmpeg` on `video`, asking for RGB frames when `colour` is true.
+    pub(crate) fn spawn(ffmpeg: &Path, video: &Path, colour: bool) -> Result<Self> {
+        let pixel_format = if colour { "rgb24" } else { "gray16le" };
         let child = Command::new(ffmpeg)
             .args(["-v", "error", "-nostdin", "-i"])
             .arg(video)
-            .args(["-f", "rawvideo", "-pix_fmt", "gray16le", "-"])
+            .args(["-f", "rawvideo", "-pix_fmt", pixel_format, "-"])
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
             .map_err(|e| missing_program(ffmpeg, e))?;
-        Ok(Self { child })
+        Ok(Self { child, colour })
     }
 
     /// Hands the frames to `emit` in order until it returns `false` or the video ends; a
@@ -96,7 +103,7 @@ impl FfmpegDecoder {
     pub(crate) fn read_frames(
         mut self,
         info: VideoInfo,
-        mut emit: impl FnMut(std::result::Result<GrayImage, String>) -> bool,
+        mut emit: impl FnMut(DecodeResult<Decoded>) -> bool,
     ) {
         let (Some(mut stdout), Some(mut stderr)) =
             (self.child.stdout.take(), self.child.stderr.take())
@@ -110,7 +117,8 @@ impl FfmpegDecoder {
             let _ = stderr.read_to_string(&mut text);
             text
         });
-        let mut bytes = vec![0u8; info.width * info.height * 2];
+        let bytes_per_pixel = if self.colour { 3 } else { 2 };
+        let mut bytes = vec![0u8; info.width * info.height * bytes_per_pixel];
         let finished = loop {
             match read_full(&mut stdout, &mut bytes) {
                 Ok(0) => break true,
@@ -122,13 +130,7 @@ impl FfmpegDecoder {
                     break false;
                 }
                 Ok(_) => {
-                    let pixels = bytes
-                        .chunks_exact(2)
-                        .map(|b| f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0)
-                        .collect();
-                    let image = GrayImage::from_vec(info.width, info.height, pixels)
-                        .map_err(|e| e.to_string());
-                    if !emit(image) {
+                    if !emit(raw_frame(&bytes, info, self.colour)) {
                         break false;
                     }
                 }
@@ -164,6 +166,29 @@ impl Drop for FfmpegDecoder {
         // Never leave a running or zombie ffmpeg behind; both calls are no-ops once it exited.
         let _ = self.child.kill();
         let _ = self.child.wait();
+    }
+}
+
+/// One raw frame from ffmpeg: little-endian 16-bit grey, or (`colour`) 8-bit RGB whose grey
+/// is its Rec. 601 luma.
+fn raw_frame(bytes: &[u8], info: VideoInfo, colour: bool) -> DecodeResult<Decoded> {
+    let (w, h) = (info.width, info.height);
+    if colour {
+        let grey = to_luma(bytes, 3, u8_unit);
+        let pixels = bytes.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        Ok(Decoded {
+            grey: GrayImage::from_vec(w, h, grey).map_err(|e| e.to_string())?,
+            colour: Some(RgbImage::from_vec(w, h, pixels).map_err(|e| e.to_string())?),
+        })
+    } else {
+        let pixels = bytes
+            .chunks_exact(2)
+            .map(|b| f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0)
+            .collect();
+        Ok(Decoded {
+            grey: GrayImage::from_vec(w, h, pixels).map_err(|e| e.to_string())?,
+            colour: None,
+        })
     }
 }
 

@@ -24,6 +24,7 @@ pub fn track_vortex(
                 index: f.index,
                 path: PathBuf::from(format!("vortex:{}", f.index)),
                 image: f.image,
+                colour: None,
             })
         });
     let mut tracks = Vec::new();
