@@ -13,6 +13,9 @@
 //! - [`MotionModel`]s: the bedload motions of Eq. (3) with jump-Markov switching
 //!   ([`BedloadModel`]), and constant position / velocity / acceleration
 //!   ([`KinematicModel`], [`Switching`]).
+//! - [`ImmParticleFilter`]: the IMM particle filter of the pedestrian paper (§4): a model
+//!   label per particle, model weights π (Eqs. (6)-(9)), resampling over all particles every ρ
+//!   frames and per model every φ frames with at least γ particles per model (§4.4).
 //! - [`KalmanFilter`] and [`KalmanImm`] over small fixed-size matrices, for the IMM baseline.
 //! - [`fit_bedload`]: the transition table of Eq. (11) and the process noises of Eq. (3)
 //!   learned from ground-truth trajectories with motion states (§4.3), for `sillage fit bedload`.
@@ -48,6 +51,7 @@ pub mod imm;
 pub mod kalman;
 pub mod linalg;
 pub mod motion;
+pub mod multiple_model;
 pub mod noise;
 pub mod normal;
 pub mod params;
@@ -69,6 +73,10 @@ pub use motion::MotionModel;
 pub use motion::bedload::{BedloadMode, BedloadModel};
 pub use motion::kinematic::{KinematicModel, Switching};
 pub use motion::prior::{MotionPrior, MotionPriorParams};
+pub use multiple_model::{
+    CompetingMotion, ImmParticleFilter, ImmPfParams, ImmPfSpec, ImmResampling, ImmWeighting,
+    linear_model,
+};
 pub use noise::{Gauss2, Noise2};
 pub use normal::Normals;
 pub use params::{

@@ -1,7 +1,8 @@
-//! Small fixed-size matrices for the Kalman filters (4×4 states, 2×2 innovations).
+//! Small fixed-size matrices for the Kalman filters (4×4 states, 2×2 innovations) and the
+//! Gaussian refill of the IMM particle filter (6×6).
 //!
 //! Hand-written rather than a dependency: the filters need products, transposes, sums and one
-//! 2×2 inverse, all on the stack.
+//! 2×2 inverse and a Cholesky factor, all on the stack.
 
 use std::ops::{Add, Mul, Sub};
 
@@ -62,6 +63,27 @@ impl<const N: usize> Matrix<N, N> {
             out.0[i][i] = d;
         }
         out
+    }
+
+    /// The lower-triangular `L` with `L·Lᵀ = self` for a symmetric positive semi-definite
+    /// matrix (a covariance to sample from): a pivot that rounding leaves at or below zero
+    /// gives a zero column, so a degenerate covariance (a coordinate with no spread) still
+    /// samples. Only the lower triangle is read.
+    pub fn cholesky_semidefinite(&self) -> Self {
+        let mut l = Self::ZERO;
+        for c in 0..N {
+            let pivot = self.0[c][c] - (0..c).map(|k| l.0[c][k] * l.0[c][k]).sum::<f64>();
+            if pivot.is_nan() || pivot <= 1e-12 * self.0[c][c].abs() || pivot.is_infinite() {
+                continue;
+            }
+            let root = pivot.sqrt();
+            l.0[c][c] = root;
+            for r in c + 1..N {
+                let dot: f64 = (0..c).map(|k| l.0[r][k] * l.0[c][k]).sum();
+                l.0[r][c] = (self.0[r][c] - dot) / root;
+            }
+        }
+        l
     }
 
     /// `(self + selfᵀ) / 2`: removes the rounding asymmetry a covariance update leaves.
@@ -193,6 +215,10 @@ mod tests {
         );
         let v = Vector::from_array([1.0, -2.0]);
         assert_eq!(v.outer().0, [[1.0, -2.0], [-2.0, 4.0]]);
+        let cov = Matrix([[4.0, 2.0, 0.0], [2.0, 5.0, 0.0], [0.0, 0.0, 0.0]]);
+        let l = cov.cholesky_semidefinite();
+        assert!((l * l.transpose()).max_abs_diff(&cov) < 1e-12);
+        assert_eq!(l.0[2], [0.0; 3]);
         assert_eq!(
             Matrix([[1.0, 2.0], [4.0, 1.0]]).symmetrised().0,
             [[1.0, 3.0], [3.0, 1.0]]

@@ -211,19 +211,19 @@ impl BedloadParams {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
 pub enum KinematicParams {
-    /// Position random walk.
+    /// Position random walk, velocity and acceleration zero (Eq. (10) of the IMM-PF paper).
     ConstantPosition {
         /// Position noise.
         pos_noise: Noise2,
     },
-    /// Constant velocity with velocity noise.
+    /// Constant velocity with velocity noise, acceleration zero (Eq. (11)).
     ConstantVelocity {
         /// Position noise.
         pos_noise: Noise2,
         /// Velocity noise.
         vel_noise: Noise2,
     },
-    /// Constant acceleration with acceleration noise.
+    /// Constant acceleration with acceleration noise (Eq. (12)).
     ConstantAcceleration {
         /// Position noise.
         pos_noise: Noise2,

@@ -85,15 +85,28 @@ impl Resampler {
         rng: &mut RngStream,
     ) -> &[u32] {
         let n = weights.len();
+        self.draw_count(scheme, weights, n, rng)
+    }
+
+    /// As [`Resampler::draw`], but `n` ancestors, whatever the number of weights: a set that
+    /// grows or shrinks (the per-model resampling of the IMM particle filter, §4.4 of the
+    /// IMM-PF paper). No ancestor is drawn from an empty weight set.
+    pub fn draw_count(
+        &mut self,
+        scheme: ResampleScheme,
+        weights: &mut [f64],
+        n: usize,
+        rng: &mut RngStream,
+    ) -> &[u32] {
         self.ancestors.clear();
         self.positions.clear();
-        if n == 0 {
+        if n == 0 || weights.is_empty() {
             return &self.ancestors;
         }
         let mut total: f64 = weights.iter().sum();
         if !(total > 0.0 && total.is_finite()) {
             weights.fill(1.0);
-            total = n as f64;
+            total = weights.len() as f64;
         }
         let step = total / n as f64;
         match scheme {
@@ -208,6 +221,22 @@ mod tests {
             // A degenerate set is treated as uniform rather than refused.
             let mut w = [0.0; 3];
             assert_eq!(resampler.draw(scheme, &mut w, &mut rng).len(), 3);
+        }
+    }
+
+    #[test]
+    fn a_set_can_grow_or_shrink() {
+        let mut rng = rng_stream(3, 4);
+        let mut resampler = Resampler::default();
+        for scheme in [ResampleScheme::Systematic, ResampleScheme::Residual] {
+            let mut w = [0.0, 0.75, 0.25];
+            let drawn = resampler.draw_count(scheme, &mut w, 8, &mut rng).to_vec();
+            assert_eq!(drawn.len(), 8);
+            let ones = drawn.iter().filter(|&&i| i == 1).count();
+            assert_eq!(ones, 6, "{scheme:?}: {drawn:?}");
+            assert!(drawn.iter().all(|&i| i == 1 || i == 2));
+            assert!(resampler.draw_count(scheme, &mut [], 5, &mut rng).is_empty());
+            assert_eq!(resampler.draw_count(scheme, &mut w, 1, &mut rng).len(), 1);
         }
     }
 

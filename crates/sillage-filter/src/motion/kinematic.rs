@@ -1,6 +1,7 @@
-//! Constant position, constant velocity and constant acceleration models, alone or switched
-//! by a transition table (the models of the pedestrian IMM particle filter). The per-particle
-//! steps here are also the building blocks of the bedload motions of Eq. (3).
+//! Constant position, constant velocity and constant acceleration models (Eqs. (10)-(12) of
+//! the IMM-PF paper), alone, switched by a transition table, or competing inside the IMM
+//! particle filter. The per-particle steps here are also the building blocks of the bedload
+//! motions of Eq. (3) of the MMPF+ paper.
 
 use sillage_core::{Error, Result, RngStream};
 
@@ -43,22 +44,23 @@ pub(crate) fn constant_velocity(
     c.vel_y[i] += dv;
 }
 
-/// A validated kinematic model over `(x, y, u, v[, aₓ, a_y])`, one frame per step.
+/// A validated kinematic model over `(x, y, u, v[, aₓ, a_y])`, one frame per step (T = 1):
+/// `X ← A_k·X + ν` with the matrices of Eqs. (10)-(12) of the IMM-PF paper.
 #[derive(Debug, Clone, PartialEq)]
 pub enum KinematicModel {
-    /// Random walk of the position; velocity kept.
+    /// Eq. (10): `x ← x + ε_x`; velocity and acceleration reduced to zero.
     ConstantPosition {
         /// Position noise.
         pos: Gauss2,
     },
-    /// `x ← x + u + ε_x`, `u ← u + ε_u`.
+    /// Eq. (11): `x ← x + u + ε_x`, `u ← u + ε_u`; acceleration reduced to zero.
     ConstantVelocity {
         /// Position noise.
         pos: Gauss2,
         /// Velocity noise.
         vel: Gauss2,
     },
-    /// `x ← x + u + a/2 + ε_x`, `u ← u + a + ε_u`, `a ← a + ε_a`.
+    /// Eq. (12): `x ← x + u + a/2 + ε_x`, `u ← u + a + ε_u`, `a ← a + ε_a`.
     ConstantAcceleration {
         /// Position noise.
         pos: Gauss2,
@@ -96,16 +98,25 @@ impl KinematicModel {
         })
     }
 
-    fn uses_acceleration(&self) -> bool {
+    /// Whether the model reads the acceleration columns (the constant-acceleration model).
+    pub(crate) fn uses_acceleration(&self) -> bool {
         matches!(self, Self::ConstantAcceleration { .. })
     }
 
     /// Moves particle `i` one frame.
     #[inline]
-    fn advance(&self, c: &mut Columns<'_>, i: usize, normals: &mut Normals<'_>) {
+    pub(crate) fn advance(&self, c: &mut Columns<'_>, i: usize, normals: &mut Normals<'_>) {
         match self {
-            Self::ConstantPosition { pos } => constant_position(c, i, pos, 1.0, normals),
-            Self::ConstantVelocity { pos, vel } => constant_velocity(c, i, pos, vel, 1.0, normals),
+            Self::ConstantPosition { pos } => {
+                constant_position(c, i, pos, 1.0, normals);
+                c.vel_x[i] = 0.0;
+                c.vel_y[i] = 0.0;
+                zero_acceleration(c, i);
+            }
+            Self::ConstantVelocity { pos, vel } => {
+                constant_velocity(c, i, pos, vel, 1.0, normals);
+                zero_acceleration(c, i);
+            }
             Self::ConstantAcceleration { pos, vel, acc } => {
                 let (dx, dy) = pos.sample(1.0, normals);
                 let (du, dv) = vel.sample(1.0, normals);
@@ -119,6 +130,16 @@ impl KinematicModel {
                 c.acc_y[i] += day;
             }
         }
+    }
+}
+
+/// Sets particle `i`'s acceleration to zero where the set has acceleration columns (the zero
+/// blocks of `A₁` and `A₂`, Eqs. (10)-(11) of the IMM-PF paper).
+#[inline]
+fn zero_acceleration(c: &mut Columns<'_>, i: usize) {
+    if let (Some(ax), Some(ay)) = (c.acc_x.get_mut(i), c.acc_y.get_mut(i)) {
+        *ax = 0.0;
+        *ay = 0.0;
     }
 }
 
