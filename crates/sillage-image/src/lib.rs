@@ -11,7 +11,10 @@
 //!   level (median and MAD of a fixed subsample);
 //! - [`background`]: TracTrac's slew-limited background model (Eqs. (1)–(2));
 //! - [`levels`]: 8-bit grey levels, encoded from and decoded to `f32` frames;
-//! - [`mask`]: masks and rectangular regions of interest ([`Roi`]).
+//! - [`mask`]: masks and rectangular regions of interest ([`Roi`]);
+//! - [`histogram`]: HSV colour and frame-difference histograms of boxes ([`BinImage`],
+//!   [`HsvBinning`]) compared by the Bhattacharyya coefficient, the observation model of the
+//!   pedestrian IMM particle filter (Pérez, Vermaak & Blake 2004).
 //!
 //! Filters own their scratch buffers, so processing frame after frame allocates nothing once
 //! the first frame has sized them, and every result is bit-identical whatever the number of
@@ -46,6 +49,7 @@ pub mod bandpass;
 pub mod box_mean;
 pub mod components;
 pub mod gaussian;
+pub mod histogram;
 pub mod levels;
 pub mod mask;
 pub mod maxima;
@@ -63,6 +67,10 @@ pub use bandpass::{DogFilter, LogFilter, MAX_SCALE_PX, Polarity};
 pub use box_mean::box_mean_3x3;
 pub use components::{Component, ComponentLabeller, PixelBox};
 pub use gaussian::{GaussianFilter, GaussianKernel, MAX_SIGMA_PX};
+pub use histogram::{
+    BinImage, BoxPx, HsvBinning, IntegralHistogram, MAX_BINS, bhattacharyya_coefficient,
+    bhattacharyya_distance,
+};
 pub use levels::{decode_levels, encode_levels};
 pub use mask::{Roi, apply_mask};
 pub use maxima::{Peak, PeakFinder};
