@@ -5,7 +5,7 @@ use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use sillage::eval::mot::{MotChallengeProtocol, MotConvention, Similarity};
-use sillage::filter::FitOptions;
+use sillage::filter::{FitOptions, MotionPriorParams};
 
 /// Follow many moving objects through image sequences (PTV, bedload beads, pedestrians).
 #[derive(Debug, Parser)]
@@ -29,6 +29,8 @@ const EXAMPLES: &str = "Examples:
   sillage bench ptv --particles 1000,5000,25000
   sillage bench bedload --frames 100 --real shared/data/bedload_beads_lafaye2018 --mask base.png
   sillage fit bedload --truth trackdatatruth.csv --out motion.toml
+  sillage fit motion-prior PETS09-S2L1/gt/gt.txt --out prior.json
+  sillage fit homography PETS09-S2L1/gt/gt.txt --out ground.toml
   sillage detect bead 'flume/*.tif' --sequence-params sequence_param.txt --mask base.png --out det.csv --candidates cand.csv
   sillage track bedload --detections beads/detections.csv --candidates beads/candidates.csv --out beads/tracks.csv
   sillage eval mot --gt beads/truth.csv --pred beads/tracks.csv --match disc:0.43 --papers";
@@ -499,6 +501,67 @@ pub enum FitCommand {
     /// The bedload particle filter's transition table (MMPF+ Eqs. (11)-(12)) and process noises
     /// (Eq. (3)) from ground truth with motion states, trained on the first half (§4.3).
     Bedload(FitBedloadArgs),
+    /// The learned motion prior of the pedestrian IMM particle filter (Madrigal & Hayet
+    /// §5.1): per 30 px cell, the probability of each direction and its mean velocity, from
+    /// MOTChallenge trajectories (foot points); written as JSON.
+    MotionPrior(FitMotionPriorArgs),
+    /// The image ↔ ground-plane homography (foot points ↔ world_x, world_y of MOT15 ground
+    /// truth, or `--points` pairs) and, from ground truth boxes, the adult height and width in
+    /// metres (§4); written as TOML.
+    Homography(FitHomographyArgs),
+}
+
+/// `sillage fit motion-prior`.
+#[derive(Debug, Args)]
+pub struct FitMotionPriorArgs {
+    /// Trajectories in MOTChallenge format (`gt.txt` or tracker output; rows with flag 0 are
+    /// ignored), or a sequence folder holding `gt/gt.txt`.
+    #[arg(value_name = "TRACKS")]
+    pub tracks: PathBuf,
+    /// Image width, px; default `imWidth` of the `seqinfo.ini` beside the file or above it.
+    #[arg(long, value_name = "PX")]
+    pub width: Option<u32>,
+    /// Image height, px; default `imHeight` of that `seqinfo.ini`.
+    #[arg(long, value_name = "PX")]
+    pub height: Option<u32>,
+    /// Cell side, px (§5.1 uses 30).
+    #[arg(long, value_name = "PX", default_value_t = MotionPriorParams::default().cell_px)]
+    pub cell: f64,
+    /// Steps slower than this count as "stay", px/frame.
+    #[arg(long, value_name = "PX", default_value_t = MotionPriorParams::default().min_speed_px_per_frame)]
+    pub min_speed: f64,
+    /// Dirichlet pseudo-count added to every bin of every cell.
+    #[arg(long, value_name = "N", default_value_t = MotionPriorParams::default().smoothing)]
+    pub smoothing: f64,
+    /// JSON file to write.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `sillage fit homography`.
+#[derive(Debug, Args)]
+pub struct FitHomographyArgs {
+    /// MOT15 ground truth with world coordinates
+    /// (`frame,id,bb_left,bb_top,bb_width,bb_height,flag,world_x,world_y,world_z`).
+    #[arg(
+        value_name = "GT",
+        required_unless_present = "points",
+        conflicts_with = "points"
+    )]
+    pub gt: Option<PathBuf>,
+    /// Instead of ground truth: a text file of 4 or more `u,v,x,y` lines (image px, ground m).
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+    /// TOML file to write: `[homography]` (image_from_ground), `[pedestrian]` (from ground
+    /// truth only) and `[fit]`.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `sillage fit bedload`.

@@ -252,7 +252,7 @@ fn human_summary(args: &FitBedloadArgs, fit: &BedloadFit, tracks: usize) -> Stri
 
 /// Writes `text` to a temporary file beside `path`, then renames it over `path`, so a reader
 /// never sees a half-written config.
-fn write_atomically(path: &Path, text: &str) -> Result<()> {
+pub(crate) fn write_atomically(path: &Path, text: &str) -> Result<()> {
     let name = path
         .file_name()
         .ok_or_else(|| anyhow!("{}: --out must name a file", path.display()))?;

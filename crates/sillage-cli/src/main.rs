@@ -15,6 +15,7 @@ mod eval;
 mod eval_inputs;
 mod eval_mot;
 mod fit;
+mod fit_pedestrian;
 mod overlay;
 mod progress;
 mod ptv;
@@ -40,6 +41,8 @@ fn main() {
         cli::Command::Bench(cli::BenchCommand::Bedload(a)) => bench_bedload::run(&a),
         cli::Command::Config(a) => ptv::print_config(&a),
         cli::Command::Fit(cli::FitCommand::Bedload(a)) => fit::run_bedload(&a),
+        cli::Command::Fit(cli::FitCommand::MotionPrior(a)) => fit_pedestrian::run_motion_prior(&a),
+        cli::Command::Fit(cli::FitCommand::Homography(a)) => fit_pedestrian::run_homography(&a),
         cli::Command::Track(cli::TrackCommand::Bedload(a)) => track::run_bedload(&a),
         cli::Command::Detect(cli::DetectCommand::Bead(a)) => detect::run_bead(&a),
     };

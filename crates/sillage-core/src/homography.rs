@@ -234,6 +234,41 @@ impl Homography {
     }
 }
 
+/// The real size of a pedestrian's box, m: the paper fixes it "to the average size of an
+/// adult (in world coordinates)" and projects it at the target's distance (§4).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PedestrianSize {
+    /// Box height, m.
+    pub height_m: f64,
+    /// Box width, m.
+    pub width_m: f64,
+}
+
+impl PedestrianSize {
+    /// Checks both sizes are finite and > 0; the error names the key.
+    pub fn validate(&self) -> Result<()> {
+        for (key, value) in [("height_m", self.height_m), ("width_m", self.width_m)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::parameter(
+                    key,
+                    value,
+                    "must be a finite size > 0 m (`sillage fit homography` measures it from \
+                     ground truth boxes)",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The box (width, height) in px of a pedestrian whose foot point is `foot_px`: each size
+    /// times [`Homography::px_per_metre_across`] there; `None` where the scale is undefined.
+    pub fn box_size_px(&self, homography: &Homography, foot_px: Point2) -> Option<(f64, f64)> {
+        let scale = homography.px_per_metre_across(foot_px)?;
+        Some((self.width_m * scale, self.height_m * scale))
+    }
+}
+
 /// `[s, 0, tx; 0, s, ty; 0, 0, 1]` taking `points` to centroid 0 and mean distance √2
 /// (H&Z §4.4.4); points all at one place or on one line are an error naming `plane`.
 fn similarity_normaliser(plane: &str, points: &[Point2]) -> Result<Matrix3> {
@@ -503,6 +538,33 @@ mod tests {
         ])
         .unwrap();
         assert!((s.px_per_metre_across(Point2::new(10.0, 10.0)).unwrap() - 25.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn pedestrian_boxes_scale_with_the_map() {
+        let h = Homography::from_image_from_ground([
+            [25.0, 0.0, 3.0],
+            [0.0, 25.0, 4.0],
+            [0.0, 0.0, 1.0],
+        ])
+        .unwrap();
+        let adult = PedestrianSize {
+            height_m: 1.8,
+            width_m: 0.5,
+        };
+        adult.validate().unwrap();
+        let (w, hgt) = adult.box_size_px(&h, Point2::new(50.0, 60.0)).unwrap();
+        assert!(
+            (w - 12.5).abs() < 1e-9 && (hgt - 45.0).abs() < 1e-9,
+            "{w} {hgt}"
+        );
+        let err = PedestrianSize {
+            height_m: 0.0,
+            width_m: 0.5,
+        }
+        .validate()
+        .unwrap_err();
+        assert!(err.to_string().contains("`height_m`"), "{err}");
     }
 
     #[test]

@@ -32,7 +32,7 @@ mod roles;
 pub use calibration::Calibration;
 pub use error::{Error, Result};
 pub use geometry::{Point2, Vec2};
-pub use homography::Homography;
+pub use homography::{Homography, PedestrianSize};
 pub use image::{GrayImage, Image, RgbImage};
 pub use observation::{
     BLACK_BEAD_CLASS, Detection, FrameIndex, MotionState, ObjectClass, TRANSPARENT_BEAD_CLASS,

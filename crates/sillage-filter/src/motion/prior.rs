@@ -398,19 +398,31 @@ impl MotionPrior {
         Vec2::new(mean.x + du, mean.y + dv)
     }
 
-    /// The prior as pretty-printed JSON (with [`MOTION_PRIOR_FORMAT_VERSION`]).
+    /// The prior as JSON (with [`MOTION_PRIOR_FORMAT_VERSION`]): one key per line and one
+    /// cell per line, row by row from the top-left, so the file stays small and readable.
     pub fn to_json(&self) -> String {
-        let file = MotionPriorFile {
-            format_version: MOTION_PRIOR_FORMAT_VERSION,
-            params: self.params,
-            width_px: self.width_px,
-            height_px: self.height_px,
-            columns: self.columns,
-            rows: self.rows,
-            cells: self.cells.clone(),
-        };
-        // Plain structs of numbers and strings always serialise.
-        serde_json::to_string_pretty(&file).unwrap_or_default()
+        let mut text = String::from("{\n");
+        text.push_str(&format!(
+            "  \"format_version\": {MOTION_PRIOR_FORMAT_VERSION},\n  \"params\": {},\n  \
+             \"width_px\": {},\n  \"height_px\": {},\n  \"columns\": {},\n  \"rows\": {},\n  \
+             \"cells\": [\n",
+            compact(&self.params),
+            self.width_px,
+            self.height_px,
+            self.columns,
+            self.rows
+        ));
+        for (k, cell) in self.cells.iter().enumerate() {
+            text.push_str("    ");
+            text.push_str(&compact(cell));
+            text.push_str(if k + 1 < self.cells.len() {
+                ",\n"
+            } else {
+                "\n"
+            });
+        }
+        text.push_str("  ]\n}");
+        text
     }
 
     /// Reads a prior from JSON text; `path` names the source in errors. A wrong format
@@ -517,6 +529,11 @@ impl MotionPrior {
         })?;
         Self::from_json(path, text)
     }
+}
+
+/// Compact JSON of a part of the prior file (plain structs of numbers always serialise).
+fn compact<T: Serialize>(value: &T) -> String {
+    serde_json::to_string(value).unwrap_or_default()
 }
 
 /// `.NAME.partial` beside `path`.
