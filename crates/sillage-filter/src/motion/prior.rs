@@ -1,5 +1,5 @@
 //! The learned motion prior (MP) of the pedestrian IMM particle filter (Madrigal & Hayet §5.1,
-//! after their ref. [9]): the image is divided into cells of 30×30 px and, in each cell, the
+//! after their ref. \[9\]): the image is divided into cells of 30×30 px and, in each cell, the
 //! probability of moving from this cell towards each neighbouring direction is learned from
 //! trajectories; "for a given particle, we determine its corresponding cell and then sample a
 //! velocity from the prior".
