@@ -6,7 +6,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use sillage_core::RgbImage;
-use sillage_image::{BinImage, BoxPx, HsvBinning, IntegralHistogram, Roi};
+use sillage_image::{BinImage, BoxPx, HsvBinning};
 
 /// SplitMix64.
 fn next(state: &mut u64) -> u64 {
@@ -58,14 +58,9 @@ fn bench_histograms(c: &mut Criterion) {
     let binning = HsvBinning::default();
     let mut bins = BinImage::new();
     bins.fill_hsv(&rgb, &binning).unwrap();
-    let roi = Roi {
-        x0: 300,
-        y0: 200,
-        x1: 420,
-        y1: 400,
-    };
     let mut state = 7u64;
     let mut unit = || (next(&mut state) >> 11) as f64 / (1u64 << 53) as f64;
+    // 200 boxes inside one person's 120×200 px region of interest at (300, 200).
     let boxes: Vec<BoxPx> = (0..200)
         .map(|_| {
             let (x, y) = (300.0 + unit() * 90.0, 200.0 + unit() * 120.0);
@@ -92,20 +87,6 @@ fn bench_histograms(c: &mut Criterion) {
             })
         });
     }
-    let mut integral = IntegralHistogram::new();
-    group.bench_function("integral_fill_roi_120x200", |b| {
-        b.iter(|| integral.fill(black_box(&bins), roi))
-    });
-    integral.fill(&bins, roi);
-    group.bench_function("integral_lookup_200_boxes", |b| {
-        b.iter(|| {
-            for region in &boxes {
-                integral
-                    .box_histogram(black_box(region), &mut histogram)
-                    .unwrap();
-            }
-        })
-    });
     group.finish();
 }
 

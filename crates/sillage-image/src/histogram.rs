@@ -7,12 +7,15 @@
 //! A frame is binned once into a [`BinImage`] (one bin index per pixel, [`BinImage::fill_hsv`]
 //! or [`BinImage::fill_difference`]); then every particle's box costs one pass over its pixels
 //! ([`BinImage::box_histogram`], optionally sampling every `stride`-th row and column).
+//!
+//! An integral histogram (per-bin cumulative counts over one person's region of interest, 4
+//! lookups per bin and box) was measured against this direct accumulation and lost: filling
+//! it for a 120×200 px ROI costs more than 200 boxes of 30×80 px read directly (see
+//! `BENCHMARKS.md`, "HSV box histograms"), so it is not kept.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sillage_core::{Error, GrayImage, Image, Result, RgbImage};
-
-use crate::mask::Roi;
 
 /// Most bins a [`BinImage`] can hold (its bin indexes are `u8`).
 pub const MAX_BINS: usize = 256;
@@ -156,11 +159,10 @@ impl HsvTables {
                 };
                 (num * self.hue_bins / (6 * delta)).min(self.hue_bins - 1)
             };
-            let saturation = if max == 0 {
-                0
-            } else {
-                (delta * self.saturation_bins / max).min(self.saturation_bins - 1)
-            };
+            // A black pixel (possible only with `min_value = 0`) has saturation 0.
+            let saturation = (delta * self.saturation_bins)
+                .checked_div(max)
+                .map_or(0, |s| s.min(self.saturation_bins - 1));
             (hue * self.saturation_bins + saturation) as u8
         } else {
             let value = (max * self.value_bins / 255).min(self.value_bins - 1);
@@ -333,12 +335,27 @@ impl BinImage {
             histogram.fill(0.0);
             return Ok(0);
         };
-        // A `u8` index into 256 counters needs no bounds check in the inner loop.
-        let mut counts = [0u32; MAX_BINS];
+        // Four sets of counters, so runs of pixels in one bin (common in real frames) do not
+        // chain every increment on the previous one; a `u8` index into 256 counters needs no
+        // bounds check.
+        let mut lanes = [[0u32; MAX_BINS]; 4];
         for y in rows.step_by(stride) {
-            for &bin in self.image.row(y)[columns.clone()].iter().step_by(stride) {
-                counts[usize::from(bin)] += 1;
+            let row = &self.image.row(y)[columns.clone()];
+            let mut i = 0;
+            while i + 3 * stride < row.len() {
+                lanes[0][usize::from(row[i])] += 1;
+                lanes[1][usize::from(row[i + stride])] += 1;
+                lanes[2][usize::from(row[i + 2 * stride])] += 1;
+                lanes[3][usize::from(row[i + 3 * stride])] += 1;
+                i += 4 * stride;
             }
+            for &bin in row[i.min(row.len())..].iter().step_by(stride) {
+                lanes[0][usize::from(bin)] += 1;
+            }
+        }
+        let mut counts = [0u32; MAX_BINS];
+        for (b, count) in counts[..self.bins].iter_mut().enumerate() {
+            *count = lanes[0][b] + lanes[1][b] + lanes[2][b] + lanes[3][b];
         }
         Ok(normalise(&counts[..self.bins], histogram))
     }
@@ -382,113 +399,4 @@ pub fn bhattacharyya_coefficient(a: &[f32], b: &[f32]) -> f64 {
 /// coefficient of two equal histograms above 1.
 pub fn bhattacharyya_distance(a: &[f32], b: &[f32]) -> f64 {
     (1.0 - bhattacharyya_coefficient(a, b)).max(0.0).sqrt()
-}
-
-/// Per-bin cumulative counts over a region of interest of a [`BinImage`] (an integral
-/// histogram), so that the histogram of any box inside it costs 4 lookups per bin whatever
-/// the box's size. Its buffers are reused from frame to frame.
-#[derive(Debug, Clone)]
-pub struct IntegralHistogram {
-    roi: Roi,
-    bins: usize,
-    /// `(roi.width() + 1) × (roi.height() + 1)` cells of `bins` counts: cell `(x, y)` counts
-    /// the pixels of the ROI left of column `x` and above row `y`.
-    cumulative: Vec<u32>,
-    row: Vec<u32>,
-}
-
-impl Default for IntegralHistogram {
-    fn default() -> Self {
-        Self {
-            roi: Roi::full(0, 0),
-            bins: 0,
-            cumulative: Vec::new(),
-            row: Vec::new(),
-        }
-    }
-}
-
-impl IntegralHistogram {
-    /// An empty integral histogram, to be filled by [`fill`](Self::fill).
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Accumulates the bins of the pixels of `roi` (clipped to the image), e.g. the union of
-    /// one target's particle boxes.
-    pub fn fill(&mut self, bins: &BinImage, roi: Roi) {
-        let (width, height) = bins.image().dimensions();
-        let roi = Roi {
-            x0: roi.x0.min(width),
-            y0: roi.y0.min(height),
-            x1: roi.x1.min(width),
-            y1: roi.y1.min(height),
-        };
-        let (w, h, n) = (roi.width(), roi.height(), bins.bins());
-        self.roi = roi;
-        self.bins = n;
-        self.cumulative.clear();
-        self.cumulative.resize((w + 1) * (h + 1) * n, 0);
-        self.row.clear();
-        self.row.resize(n, 0);
-        let stride = (w + 1) * n;
-        for y in 0..h {
-            self.row.fill(0);
-            let source = &bins.image().row(roi.y0 + y)[roi.x0..roi.x1];
-            let (above, below) = self.cumulative.split_at_mut((y + 1) * stride);
-            let above = &above[y * stride..];
-            for (x, &bin) in source.iter().enumerate() {
-                self.row[usize::from(bin)] += 1;
-                let cell = (x + 1) * n..(x + 2) * n;
-                for ((out, &up), &left) in below[cell.clone()]
-                    .iter_mut()
-                    .zip(&above[cell])
-                    .zip(&self.row)
-                {
-                    *out = up + left;
-                }
-            }
-        }
-    }
-
-    /// The normalised histogram of the pixels of `region` clipped to the ROI, as
-    /// [`BinImage::box_histogram`] with stride 1; returns the number of pixels counted.
-    pub fn box_histogram(&self, region: &BoxPx, histogram: &mut [f32]) -> Result<usize> {
-        if histogram.len() != self.bins {
-            return Err(Error::input(format!(
-                "a histogram of {} entries was given for an integral histogram of {} bins",
-                histogram.len(),
-                self.bins
-            )));
-        }
-        let shifted = BoxPx {
-            x_min: region.x_min - self.roi.x0 as f64,
-            y_min: region.y_min - self.roi.y0 as f64,
-            x_max: region.x_max - self.roi.x0 as f64,
-            y_max: region.y_max - self.roi.y0 as f64,
-        };
-        let Some((columns, rows)) = shifted.pixel_range(self.roi.width(), self.roi.height()) else {
-            histogram.fill(0.0);
-            return Ok(0);
-        };
-        let n = self.bins;
-        let stride = (self.roi.width() + 1) * n;
-        let cell = |x: usize, y: usize| &self.cumulative[y * stride + x * n..][..n];
-        let (top_left, top_right) = (
-            cell(columns.start, rows.start),
-            cell(columns.end, rows.start),
-        );
-        let (bottom_left, bottom_right) =
-            (cell(columns.start, rows.end), cell(columns.end, rows.end));
-        let total = columns.len() * rows.len();
-        let scale = 1.0 / total as f32;
-        for (b, h) in histogram.iter_mut().enumerate() {
-            let count = bottom_right[b]
-                .wrapping_sub(bottom_left[b])
-                .wrapping_sub(top_right[b])
-                .wrapping_add(top_left[b]);
-            *h = count as f32 * scale;
-        }
-        Ok(total)
-    }
 }

@@ -68,8 +68,7 @@ pub use box_mean::box_mean_3x3;
 pub use components::{Component, ComponentLabeller, PixelBox};
 pub use gaussian::{GaussianFilter, GaussianKernel, MAX_SIGMA_PX};
 pub use histogram::{
-    BinImage, BoxPx, HsvBinning, IntegralHistogram, MAX_BINS, bhattacharyya_coefficient,
-    bhattacharyya_distance,
+    BinImage, BoxPx, HsvBinning, MAX_BINS, bhattacharyya_coefficient, bhattacharyya_distance,
 };
 pub use levels::{decode_levels, encode_levels};
 pub use mask::{Roi, apply_mask};

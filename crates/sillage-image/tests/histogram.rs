@@ -1,11 +1,9 @@
 //! HSV and difference binning against a naive `f64` reference, box histograms against a
-//! per-pixel scan, the integral histogram against the direct one, and the Bhattacharyya
-//! coefficient.
+//! per-pixel scan, and the Bhattacharyya coefficient.
 
 use sillage_core::{Error, GrayImage, RgbImage};
 use sillage_image::{
-    BinImage, BoxPx, HsvBinning, IntegralHistogram, Roi, bhattacharyya_coefficient,
-    bhattacharyya_distance,
+    BinImage, BoxPx, HsvBinning, bhattacharyya_coefficient, bhattacharyya_distance,
 };
 
 /// SplitMix64, for seeded test images.
@@ -338,48 +336,6 @@ fn difference_bins_match_the_reference_and_sizes_must_agree() {
         bins.fill_difference(&previous, &current, 10, f32::NAN)
             .is_err()
     );
-}
-
-#[test]
-fn integral_histogram_equals_the_direct_one() {
-    let rgb = random_rgb(80, 60, 12, Some(7));
-    let mut bins = BinImage::new();
-    bins.fill_hsv(&rgb, &HsvBinning::default()).unwrap();
-    let mut integral = IntegralHistogram::new();
-    let mut rng = Rng(3);
-    let (mut direct, mut fast) = (vec![0.0; 110], vec![0.0; 110]);
-    // A region of interest inside the image with boxes inside it, then the whole image with
-    // boxes partly outside.
-    let roi = Roi {
-        x0: 12,
-        y0: 7,
-        x1: 70,
-        y1: 55,
-    };
-    integral.fill(&bins, roi);
-    for _ in 0..200 {
-        let (x, y) = (12.0 + rng.unit() * 40.0, 7.0 + rng.unit() * 20.0);
-        let region = BoxPx {
-            x_min: x,
-            y_min: y,
-            x_max: x + rng.unit() * 18.0,
-            y_max: y + rng.unit() * 28.0,
-        };
-        let n = integral.box_histogram(&region, &mut fast).unwrap();
-        assert_eq!(n, bins.box_histogram(&region, 1, &mut direct).unwrap());
-        for (a, b) in fast.iter().zip(&direct) {
-            assert!((a - b).abs() < 1e-6, "{region:?}");
-        }
-    }
-    integral.fill(&bins, Roi::full(80, 60));
-    for _ in 0..200 {
-        let region = random_box(&mut rng, 80, 60);
-        let n = integral.box_histogram(&region, &mut fast).unwrap();
-        assert_eq!(n, bins.box_histogram(&region, 1, &mut direct).unwrap());
-        for (a, b) in fast.iter().zip(&direct) {
-            assert!((a - b).abs() < 1e-6, "{region:?}");
-        }
-    }
 }
 
 #[test]
