@@ -444,6 +444,59 @@ pub enum BenchCommand {
     /// Fig. 6 on a rendered synthetic sequence and, with --real, on a real one; --plots draws
     /// Figs. 6 and 7.
     Bedload(BenchBedloadArgs),
+    /// The IMM-PF paper's evaluation (Tables 1-2): each model combination on MOTChallenge
+    /// sequences, VACE (SFDA, ATA, N-MODP, MOTP), CLEAR MOT, IDF1 and HOTA, medians over
+    /// seeds; or, with --detections-only, on detections alone.
+    Immpf(BenchImmpfArgs),
+}
+
+/// The paper's seven model combinations (Table 1).
+pub const IMMPF_COMBINATIONS: [&str; 7] = [
+    "CA",
+    "CV",
+    "MP",
+    "CV_CA",
+    "CV_CA_MP",
+    "CP_CV_CA",
+    "CP_CV_CA_MP",
+];
+
+/// `sillage bench immpf`.
+#[derive(Debug, Args)]
+pub struct BenchImmpfArgs {
+    /// MOTChallenge sequence folders (`img1/`, `det/det.txt`, `gt/gt.txt`, `seqinfo.ini`).
+    #[arg(required = true)]
+    pub sequences: Vec<PathBuf>,
+    /// Model combinations, comma-separated (default: the paper's seven).
+    #[arg(long, value_delimiter = ',', default_values_t = IMMPF_COMBINATIONS.map(String::from))]
+    pub models: Vec<String>,
+    /// Seeds per combination; the table gives medians (the paper: 30).
+    #[arg(long, default_value_t = 30)]
+    pub runs: usize,
+    /// Track `det/det.txt` alone (no frames): for sequences without images.
+    #[arg(long)]
+    pub detections_only: bool,
+    /// With frames, start trackers on `det/det.txt` instead of motion blobs.
+    #[arg(long)]
+    pub births_from_detections: bool,
+    /// Ground plane for box sizes (see `sillage track immpf --ground-plane`).
+    #[arg(long, value_name = "FILE")]
+    pub ground_plane: Option<PathBuf>,
+    /// Motion prior for MP (default: learned from the sequence's own CV_CA tracks, no truth).
+    #[arg(long, value_name = "FILE")]
+    pub motion_prior: Option<PathBuf>,
+    /// TOML parameters, as `sillage track immpf --config`.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Override one key (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<String>,
+    /// Use the first N frames of each sequence.
+    #[arg(long, value_name = "N")]
+    pub max_frames: Option<usize>,
+    /// Print the rows as JSON instead of a Markdown table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `sillage bench bedload`.
@@ -595,6 +648,83 @@ pub enum TrackCommand {
     /// Bedload beads: MMPF+ (default) or a baseline of its Table 1, from detections with
     /// classes (0 black, 1 transparent); writes BeadTracking's CSV layout.
     Bedload(TrackBedloadArgs),
+    /// Pedestrians: one IMM particle filter per person, constant position / velocity /
+    /// acceleration and a learned motion prior competing (Madrigal & Hayet), on colour frames
+    /// or, without frames, on detections alone; writes MOTChallenge results.
+    Immpf(TrackImmpfArgs),
+}
+
+/// A frame size written `WIDTHxHEIGHT`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FrameSize(pub (usize, usize));
+
+impl std::str::FromStr for FrameSize {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (w, h) = text
+            .split_once(['x', 'X'])
+            .ok_or_else(|| format!("`{text}` is not WIDTHxHEIGHT, e.g. 768x576"))?;
+        let parse = |v: &str| {
+            v.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&n| n > 0)
+                .ok_or_else(|| format!("`{text}`: `{v}` is not a size in px > 0"))
+        };
+        Ok(Self((parse(w)?, parse(h)?)))
+    }
+}
+
+/// `sillage track immpf`.
+#[derive(Debug, Args)]
+pub struct TrackImmpfArgs {
+    /// Colour frames (a folder, a quoted glob, a multi-page TIFF or a video); without them,
+    /// `--detections` alone are tracked.
+    #[arg(required_unless_present = "detections")]
+    pub input: Option<String>,
+    /// MOTChallenge detections (`frame,-1,left,top,width,height,score,...`): the birth
+    /// candidates instead of motion blobs; without frames, also the measurements.
+    #[arg(long, value_name = "FILE")]
+    pub detections: Option<PathBuf>,
+    /// Frame size `WxH` for detections alone (default: the `seqinfo.ini` of a MOTChallenge
+    /// sequence folder `SEQ/det/det.txt`).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<FrameSize>,
+    /// Ground plane (TOML: `[homography]` and `adult_height_m`, `adult_width_m`; written by
+    /// `sillage fit homography`): boxes sized by an adult's size at the foot point (§4).
+    /// Without it each tracker keeps the size of the blob or detection it was born on.
+    #[arg(long, value_name = "FILE")]
+    pub ground_plane: Option<PathBuf>,
+    /// Learned motion prior (JSON from `sillage fit motion-prior`), needed by MP.
+    #[arg(long, value_name = "FILE")]
+    pub motion_prior: Option<PathBuf>,
+    /// The competing models as the paper writes them: CA, CV, MP, CV_CA, CV_CA_MP,
+    /// CP_CV_CA, CP_CV_CA_MP, ... (default CV_CA).
+    #[arg(long, value_name = "MODELS")]
+    pub models: Option<String>,
+    /// MOTChallenge results to write (1-based frames).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Also write `frame,id,<model weights>` for every result row.
+    #[arg(long, value_name = "FILE")]
+    pub model_weights: Option<PathBuf>,
+    /// TOML parameters: `[tracker]` (filter, models, noises, appearance, detection, death,
+    /// births) and `[motion_detector]`.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Override one key, e.g. `--set tracker.filter.particles=100` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<String>,
+    /// Random seed of the particles.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Stop after this many frames.
+    #[arg(long, value_name = "N")]
+    pub max_frames: Option<usize>,
+    /// Print a machine-readable summary on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// The trackers of `sillage track bedload --tracker`.

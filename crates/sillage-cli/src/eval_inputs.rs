@@ -340,22 +340,7 @@ pub fn load_sequence(
     protocol: MotChallengeProtocol,
 ) -> Result<LoadedSequence> {
     let (gt_objects, frame_count) = read_objects(&paths.gt, true)?;
-    let bead_params = match (rule, &gt_objects) {
-        (MatchRule::Disc { .. }, Objects::Beads(_)) => Some(bead_params(&paths.gt)?),
-        _ => None,
-    };
-    let shapes = Shapes { rule, bead_params };
-    let truth = shapes
-        .of(&gt_objects, &paths.gt)?
-        .into_iter()
-        .zip(roles(&gt_objects, protocol))
-        .map(|((frame, id, shape), role)| MotTruth {
-            frame,
-            id,
-            shape,
-            role,
-        })
-        .collect();
+    let (shapes, truth) = truth_of(&gt_objects, &paths.gt, rule, protocol)?;
     let (pred_objects, _) = read_objects(&paths.pred, false)?;
     let estimates = shapes
         .of(&pred_objects, &paths.pred)?
@@ -372,6 +357,44 @@ pub fn load_sequence(
         frame_count,
         states,
     })
+}
+
+/// Reads the ground truth `gt` alone, as [`load_sequence`] does: the true objects and the
+/// `seqLength` of its `seqinfo.ini`, when there is one.
+pub fn load_truth(
+    gt: &Path,
+    rule: MatchRule,
+    protocol: MotChallengeProtocol,
+) -> Result<(Vec<MotTruth>, Option<u64>)> {
+    let (objects, frame_count) = read_objects(gt, true)?;
+    let (_, truth) = truth_of(&objects, gt, rule, protocol)?;
+    Ok((truth, frame_count))
+}
+
+/// The shapes `rule` compares and the true objects of `objects`, read from `gt`.
+fn truth_of(
+    objects: &Objects,
+    gt: &Path,
+    rule: MatchRule,
+    protocol: MotChallengeProtocol,
+) -> Result<(Shapes, Vec<MotTruth>)> {
+    let bead_params = match (rule, objects) {
+        (MatchRule::Disc { .. }, Objects::Beads(_)) => Some(bead_params(gt)?),
+        _ => None,
+    };
+    let shapes = Shapes { rule, bead_params };
+    let truth = shapes
+        .of(objects, gt)?
+        .into_iter()
+        .zip(roles(objects, protocol))
+        .map(|((frame, id, shape), role)| MotTruth {
+            frame,
+            id,
+            shape,
+            role,
+        })
+        .collect();
+    Ok((shapes, truth))
 }
 
 /// The roles of ground-truth objects: MOTChallenge rows by `protocol`, the rest scored.

@@ -20,6 +20,7 @@ use sillage::io::{MotFileRole, MotRow, read_mot_rows, read_mot_sequence};
 
 use crate::cli::{FitHomographyArgs, FitMotionPriorArgs};
 use crate::fit::write_atomically;
+use crate::ground_plane::{FitTable, GroundPlaneFile};
 
 /// One trajectory: its foot points by frame.
 type Track = Vec<(FrameIndex, Point2)>;
@@ -149,23 +150,6 @@ fn group_tracks(path: &Path, rows: &[MotRow]) -> Result<(Vec<Track>, usize)> {
     Ok((tracks, ignored))
 }
 
-/// The `[fit]` table: where the homography comes from and how well it fits.
-#[derive(Serialize)]
-struct FitTable {
-    source: String,
-    pairs: usize,
-    rms_reprojection_px: f64,
-}
-
-/// The written TOML file.
-#[derive(Serialize)]
-struct HomographyFile {
-    homography: Homography,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pedestrian: Option<PedestrianSize>,
-    fit: FitTable,
-}
-
 /// `sillage fit homography (GT | --points FILE) --out ground.toml`.
 pub fn run_homography(args: &FitHomographyArgs) -> Result<()> {
     let (source, pairs, boxes) = match (&args.gt, &args.points) {
@@ -189,14 +173,14 @@ pub fn run_homography(args: &FitHomographyArgs) -> Result<()> {
             )
         })?)
     };
-    let file = HomographyFile {
+    let file = GroundPlaneFile {
         homography,
         pedestrian,
-        fit: FitTable {
+        fit: Some(FitTable {
             source: source.display().to_string(),
             pairs: pairs.len(),
             rms_reprojection_px: rms,
-        },
+        }),
     };
     let mut text = String::new();
     let _ = writeln!(

@@ -7,6 +7,7 @@ mod bead_output;
 mod bench;
 mod bench_bedload;
 mod bench_bedload_plots;
+mod bench_immpf;
 mod cli;
 mod demo;
 mod demo_bedload;
@@ -16,12 +17,15 @@ mod eval_inputs;
 mod eval_mot;
 mod fit;
 mod fit_pedestrian;
+mod ground_plane;
 mod overlay;
+mod pedestrian_input;
 mod progress;
 mod ptv;
 mod synth;
 mod synth_bedload;
 mod track;
+mod track_immpf;
 
 use clap::Parser;
 
@@ -39,11 +43,13 @@ fn main() {
         },
         cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
         cli::Command::Bench(cli::BenchCommand::Bedload(a)) => bench_bedload::run(&a),
+        cli::Command::Bench(cli::BenchCommand::Immpf(a)) => bench_immpf::run(&a),
         cli::Command::Config(a) => ptv::print_config(&a),
         cli::Command::Fit(cli::FitCommand::Bedload(a)) => fit::run_bedload(&a),
         cli::Command::Fit(cli::FitCommand::MotionPrior(a)) => fit_pedestrian::run_motion_prior(&a),
         cli::Command::Fit(cli::FitCommand::Homography(a)) => fit_pedestrian::run_homography(&a),
         cli::Command::Track(cli::TrackCommand::Bedload(a)) => track::run_bedload(&a),
+        cli::Command::Track(cli::TrackCommand::Immpf(a)) => track_immpf::run(&a),
         cli::Command::Detect(cli::DetectCommand::Bead(a)) => detect::run_bead(&a),
     };
     if let Err(error) = outcome {

@@ -269,8 +269,12 @@ impl ImmParticleFilter {
     /// The resampling of §4.4 due at this step: over all particles when the step count is a
     /// multiple of ρ, per model when it is a multiple of φ.
     pub fn resample(&mut self) -> ImmResampling {
-        let all = self.steps.is_multiple_of(self.spec.params.resample_all_every);
-        let per_model = self.steps.is_multiple_of(self.spec.params.resample_models_every);
+        let all = self
+            .steps
+            .is_multiple_of(self.spec.params.resample_all_every);
+        let per_model = self
+            .steps
+            .is_multiple_of(self.spec.params.resample_models_every);
         if all {
             self.resample_all();
         }

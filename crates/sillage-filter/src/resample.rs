@@ -235,7 +235,11 @@ mod tests {
             let ones = drawn.iter().filter(|&&i| i == 1).count();
             assert_eq!(ones, 6, "{scheme:?}: {drawn:?}");
             assert!(drawn.iter().all(|&i| i == 1 || i == 2));
-            assert!(resampler.draw_count(scheme, &mut [], 5, &mut rng).is_empty());
+            assert!(
+                resampler
+                    .draw_count(scheme, &mut [], 5, &mut rng)
+                    .is_empty()
+            );
             assert_eq!(resampler.draw_count(scheme, &mut w, 1, &mut rng).len(), 1);
         }
     }

@@ -5,6 +5,8 @@
 //!   filter (Heyman, TracTrac, §3.1.2–3.1.4).
 //! - [`bedload`]: MMPF+, the multi-model particle filter of bedload beads, and the MMPF, PF,
 //!   Kalman IMM and deterministic baselines of its Table 1 (Lafaye de Micheaux et al. 2018).
+//! - [`immpf`]: pedestrians, one IMM particle filter per person with competing motion models
+//!   (Madrigal & Hayet).
 //!
 //! ```
 //! use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker};
@@ -29,4 +31,5 @@
 //! ```
 
 pub mod bedload;
+pub mod immpf;
 pub mod ptv;

@@ -1,0 +1,202 @@
+//! The inputs of the pedestrian tracker, frame by frame: colour frames binned for the
+//! observation model with their motion blobs as birth candidates, or MOTChallenge detections
+//! (as birth candidates beside the frames, or alone in the detections-only mode).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail, ensure};
+use sillage::core::FrameIndex;
+use sillage::detect::motion::{MotionBlob, MotionDetector, MotionParams};
+use sillage::io::read_mot_rows;
+use sillage::io::{FrameOptions, FrameSource, open_frames};
+use sillage::track::immpf::{AppearanceParams, Candidate, FrameCues, PersonBox};
+
+/// One frame ready for the tracker.
+pub struct PreparedFrame {
+    /// 0-based frame index.
+    pub frame: FrameIndex,
+    /// Colour and motion bins (image mode).
+    pub cues: Option<FrameCues>,
+    /// Birth candidates (and, without cues, the measurements).
+    pub candidates: Vec<Candidate>,
+}
+
+/// Where the frames and candidates come from.
+pub struct PedestrianInput {
+    frames: Option<FrameSource>,
+    detections: Option<BTreeMap<FrameIndex, Vec<Candidate>>>,
+    motion: Option<MotionDetector>,
+    appearance: AppearanceParams,
+    cues: FrameCues,
+    /// Frames in the detections-only mode: 0 to the last detection frame (or `frame_count`).
+    next_frame: FrameIndex,
+    end_frame: FrameIndex,
+    /// (width, height), px.
+    pub frame_size_px: (usize, usize),
+    /// Frames to expect, when known.
+    pub len: Option<usize>,
+}
+
+/// Reads a MOTChallenge detections file as candidates by 0-based frame.
+pub fn read_candidates(path: &Path) -> Result<BTreeMap<FrameIndex, Vec<Candidate>>> {
+    let rows = read_mot_rows(path)?;
+    ensure!(
+        !rows.is_empty(),
+        "{} holds no detection; give a MOTChallenge file with rows \
+         `frame,-1,left,top,width,height,score,...`",
+        path.display()
+    );
+    let mut frames: BTreeMap<FrameIndex, Vec<Candidate>> = BTreeMap::new();
+    for row in rows {
+        frames.entry(row.frame).or_default().push(Candidate {
+            bbox: PersonBox {
+                left_px: row.left_px,
+                top_px: row.top_px,
+                width_px: row.width_px,
+                height_px: row.height_px,
+            },
+            score: row.confidence.unwrap_or(1.0),
+        });
+    }
+    Ok(frames)
+}
+
+/// The frame size of a MOTChallenge sequence, from the `seqinfo.ini` beside the folder of
+/// `file` (`SEQ/det/det.txt` → `SEQ/seqinfo.ini`).
+pub fn seqinfo_beside(file: &Path) -> Option<(PathBuf, sillage::io::SeqInfo)> {
+    let sequence = file.parent()?.parent()?;
+    let path = sequence.join("seqinfo.ini");
+    let info = sillage::io::read_seqinfo(&path).ok()?;
+    Some((path, info))
+}
+
+impl PedestrianInput {
+    /// Colour frames of `input` (motion blobs as candidates unless `detections` is given),
+    /// or, without `input`, the detections alone over frames of `frame_size_px`.
+    pub fn open(
+        input: Option<&str>,
+        detections: Option<&Path>,
+        frame_size_px: Option<(usize, usize)>,
+        motion: &MotionParams,
+        appearance: &AppearanceParams,
+        max_frames: Option<usize>,
+    ) -> Result<Self> {
+        let detections = detections.map(read_candidates).transpose()?;
+        let (frames, size, len, end) = match input {
+            Some(input) => {
+                let options = FrameOptions {
+                    colour: true,
+                    max_frames,
+                    ..FrameOptions::default()
+                };
+                let frames = open_frames(input, &options)?;
+                let size = frames.dimensions();
+                let len = frames.len();
+                (Some(frames), size, len, 0)
+            }
+            None => {
+                let Some(found) = &detections else {
+                    bail!(
+                        "give frames to track, or --detections FILE for the detections-only mode"
+                    );
+                };
+                let Some(size) = frame_size_px else {
+                    bail!(
+                        "the detections-only mode needs the frame size: give --size WxH, or keep \
+                         the MOTChallenge layout SEQ/det/det.txt with SEQ/seqinfo.ini"
+                    );
+                };
+                let last = found.keys().next_back().copied().unwrap_or(0) + 1;
+                let end = max_frames.map_or(last, |m| last.min(m as u64));
+                (None, size, Some(end as usize), end)
+            }
+        };
+        // With frames, the motion detector gives the foreground mask of the likelihood, and
+        // the birth candidates unless detections are given.
+        let motion = match &frames {
+            Some(_) => Some(MotionDetector::new(motion, size.0, size.1)?),
+            None => None,
+        };
+        Ok(Self {
+            frames,
+            detections,
+            motion,
+            appearance: appearance.clone(),
+            cues: FrameCues::default(),
+            next_frame: 0,
+            end_frame: end,
+            frame_size_px: size,
+            len,
+        })
+    }
+
+    /// The next frame, `None` at the end.
+    pub fn next_frame(&mut self) -> Result<Option<PreparedFrame>> {
+        let Some(frames) = &mut self.frames else {
+            if self.next_frame >= self.end_frame {
+                return Ok(None);
+            }
+            let frame = self.next_frame;
+            self.next_frame += 1;
+            let candidates = self.candidates_of(frame);
+            return Ok(Some(PreparedFrame {
+                frame,
+                cues: None,
+                candidates,
+            }));
+        };
+        let Some(frame) = frames.next() else {
+            return Ok(None);
+        };
+        let frame = frame?;
+        let colour = frame
+            .colour
+            .as_ref()
+            .context("the frame source gave no colour pixels")?;
+        let context = || format!("{}: frame {}", frame.path.display(), frame.index + 1);
+        let mut blobs = Vec::new();
+        let foreground = match &mut self.motion {
+            Some(detector) => {
+                detector
+                    .detect(&frame.image, &mut blobs)
+                    .with_context(context)?;
+                Some(detector.foreground())
+            }
+            None => None,
+        };
+        self.cues
+            .update(&self.appearance, colour, &frame.image, foreground)
+            .with_context(context)?;
+        let candidates = match &self.detections {
+            Some(_) => self.candidates_of(frame.index),
+            None => blobs.iter().map(blob_candidate).collect(),
+        };
+        Ok(Some(PreparedFrame {
+            frame: frame.index,
+            cues: Some(self.cues.without_history()),
+            candidates,
+        }))
+    }
+
+    fn candidates_of(&self, frame: FrameIndex) -> Vec<Candidate> {
+        self.detections
+            .as_ref()
+            .and_then(|d| d.get(&frame))
+            .cloned()
+            .unwrap_or_default()
+    }
+}
+
+/// A motion blob as a birth candidate (score 1).
+fn blob_candidate(blob: &MotionBlob) -> Candidate {
+    Candidate {
+        bbox: PersonBox {
+            left_px: blob.bbox.x0 as f64,
+            top_px: blob.bbox.y0 as f64,
+            width_px: blob.bbox.width() as f64,
+            height_px: blob.bbox.height() as f64,
+        },
+        score: 1.0,
+    }
+}

@@ -1,0 +1,231 @@
+//! `sillage track immpf`: pedestrians with one IMM particle filter each (Madrigal & Hayet),
+//! on colour frames (motion blobs or `--detections` as births) or on detections alone;
+//! writes MOTChallenge results and, with `--model-weights`, the model weights πₘ per row.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, ensure};
+use serde::{Deserialize, Serialize};
+use sillage::detect::motion::MotionParams;
+use sillage::filter::MotionPrior;
+use sillage::io::{MotResultsWriter, MotRow};
+use sillage::toml_config::{read_toml_file, set_key};
+use sillage::track::immpf::{
+    BoxSizing, ModelName, PedestrianEstimate, PedestrianFrame, PedestrianParams, PedestrianTracker,
+};
+
+use crate::cli::TrackImmpfArgs;
+use crate::ground_plane::GroundPlaneFile;
+use crate::pedestrian_input::{PedestrianInput, PreparedFrame, seqinfo_beside};
+use crate::progress::FrameProgress;
+
+/// Defaults, then `--config`, then `--set`, then `--models` and `--seed`; validated.
+pub fn load_params(args: &TrackImmpfArgs) -> Result<(PedestrianParams, MotionParams)> {
+    #[derive(Default, Serialize, Deserialize)]
+    #[serde(default, deny_unknown_fields)]
+    struct ConfigFile {
+        tracker: PedestrianParams,
+        motion_detector: MotionParams,
+    }
+    let mut config: ConfigFile = match &args.config {
+        Some(path) => read_toml_file(path)?,
+        None => ConfigFile::default(),
+    };
+    for assignment in &args.overrides {
+        set_key(&mut config, assignment)?;
+    }
+    if let Some(models) = &args.models {
+        config.tracker.models = ModelName::parse_combination(models)?;
+    }
+    config.tracker.validate()?;
+    config.motion_detector.validate()?;
+    Ok((config.tracker, config.motion_detector))
+}
+
+/// The box sizing and the motion prior of a run.
+pub fn load_scene(
+    ground: Option<&Path>,
+    prior: Option<&Path>,
+) -> Result<(BoxSizing, Option<MotionPrior>)> {
+    let sizing = match ground {
+        Some(path) => GroundPlaneFile::read_sizing(path)?,
+        None => BoxSizing::FromCandidate,
+    };
+    let prior = prior.map(MotionPrior::load).transpose()?;
+    Ok((sizing, prior))
+}
+
+/// What a run did (`--json`: as JSON on stdout).
+#[derive(Debug, Serialize)]
+struct Summary {
+    models: String,
+    frames: u64,
+    tracks: u64,
+    rows: u64,
+    ms_per_frame: f64,
+    tracking_ms_per_frame: f64,
+    out: String,
+}
+
+/// `sillage track immpf [FRAMES] [--detections FILE] --out FILE`.
+pub fn run(args: &TrackImmpfArgs) -> Result<()> {
+    let (params, motion) = load_params(args)?;
+    let (sizing, prior) = load_scene(args.ground_plane.as_deref(), args.motion_prior.as_deref())?;
+    let size = match (args.size, &args.detections) {
+        (Some(size), _) => Some(size.0),
+        (None, Some(detections)) => seqinfo_beside(detections)
+            .and_then(|(_, info)| Some((info.image_width? as usize, info.image_height? as usize))),
+        _ => None,
+    };
+    let mut input = PedestrianInput::open(
+        args.input.as_deref(),
+        args.detections.as_deref(),
+        size,
+        &motion,
+        &params.appearance,
+        args.max_frames,
+    )?;
+    let mut tracker = PedestrianTracker::new(
+        &params,
+        sizing,
+        prior.as_ref(),
+        input.frame_size_px,
+        args.seed,
+    )?;
+    let mut writer = MotResultsWriter::create(&args.out)?;
+    let mut weights = args
+        .model_weights
+        .as_deref()
+        .map(|path| ModelWeightsWriter::create(path, &params.models))
+        .transpose()?;
+    let mut progress = FrameProgress::new(input.len, "tracking");
+    let (mut frames, mut rows, mut last_id) = (0u64, 0u64, 0u64);
+    let mut estimates = Vec::new();
+    let started = Instant::now();
+    let mut tracking = std::time::Duration::ZERO;
+    while let Some(prepared) = input.next_frame()? {
+        estimates.clear();
+        let tick = Instant::now();
+        step(&mut tracker, &prepared, &mut estimates)?;
+        tracking += tick.elapsed();
+        writer.push(&mot_rows(&estimates))?;
+        if let Some(w) = &mut weights {
+            w.push(&estimates)?;
+        }
+        rows += estimates.len() as u64;
+        last_id = estimates.iter().map(|e| e.track_id).fold(last_id, u64::max);
+        frames += 1;
+        progress.tick();
+    }
+    progress.finish();
+    ensure!(frames > 0, "the input holds no frame");
+    writer.finish()?;
+    if let Some(w) = weights {
+        w.finish()?;
+    }
+    let elapsed = started.elapsed().as_secs_f64();
+    let summary = Summary {
+        models: ModelName::combination_label(&params.models),
+        frames,
+        tracks: last_id,
+        rows,
+        ms_per_frame: 1e3 * elapsed / frames as f64,
+        tracking_ms_per_frame: 1e3 * tracking.as_secs_f64() / frames as f64,
+        out: args.out.display().to_string(),
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        eprintln!(
+            "{} frames, {} tracks, {} rows with {} → {} ({:.1} ms/frame, tracking {:.1} ms/frame)",
+            summary.frames,
+            summary.tracks,
+            summary.rows,
+            summary.models,
+            summary.out,
+            summary.ms_per_frame,
+            summary.tracking_ms_per_frame
+        );
+    }
+    Ok(())
+}
+
+/// One tracker step on a prepared frame.
+pub fn step(
+    tracker: &mut PedestrianTracker,
+    prepared: &PreparedFrame,
+    out: &mut Vec<PedestrianEstimate>,
+) -> Result<()> {
+    let frame = PedestrianFrame {
+        frame: prepared.frame,
+        cues: prepared.cues.as_ref(),
+        candidates: &prepared.candidates,
+    };
+    tracker
+        .step(&frame, out)
+        .with_context(|| format!("frame {}", prepared.frame + 1))?;
+    Ok(())
+}
+
+/// Estimates as MOTChallenge result rows (confidence 1).
+pub fn mot_rows(estimates: &[PedestrianEstimate]) -> Vec<MotRow> {
+    estimates
+        .iter()
+        .map(|e| MotRow {
+            frame: e.frame,
+            id: Some(e.track_id),
+            left_px: e.bbox.left_px,
+            top_px: e.bbox.top_px,
+            width_px: e.bbox.width_px,
+            height_px: e.bbox.height_px,
+            confidence: Some(1.0),
+            class: None,
+            visibility: None,
+            world: None,
+        })
+        .collect()
+}
+
+/// `--model-weights FILE`: `frame,id,<model>...` with πₘ per row (1-based frames), written to
+/// a temporary file renamed at the end.
+struct ModelWeightsWriter {
+    path: PathBuf,
+    temporary: PathBuf,
+    out: std::io::BufWriter<std::fs::File>,
+}
+
+impl ModelWeightsWriter {
+    fn create(path: &Path, models: &[ModelName]) -> Result<Self> {
+        let temporary = path.with_extension("partial");
+        let file = std::fs::File::create(&temporary)
+            .with_context(|| format!("cannot create {}", temporary.display()))?;
+        let mut out = std::io::BufWriter::new(file);
+        let header: Vec<&str> = models.iter().map(|m| m.label()).collect();
+        writeln!(out, "frame,id,{}", header.join(","))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            temporary,
+            out,
+        })
+    }
+
+    fn push(&mut self, estimates: &[PedestrianEstimate]) -> Result<()> {
+        for e in estimates {
+            write!(self.out, "{},{}", e.frame + 1, e.track_id)?;
+            for w in &e.model_weights {
+                write!(self.out, ",{w:.4}")?;
+            }
+            writeln!(self.out)?;
+        }
+        Ok(())
+    }
+
+    fn finish(mut self) -> Result<()> {
+        self.out.flush()?;
+        drop(self.out);
+        std::fs::rename(&self.temporary, &self.path)
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}

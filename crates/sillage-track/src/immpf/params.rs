@@ -1,0 +1,270 @@
+//! Parameters of the pedestrian IMM-PF tracker, with the paper's values where it gives them.
+
+use serde::{Deserialize, Serialize};
+use sillage_core::{Error, Result};
+use sillage_filter::ImmPfParams;
+
+use super::appearance::AppearanceParams;
+
+/// A motion model that can compete inside the filter (§5.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelName {
+    /// Constant position, Eq. (10).
+    Cp,
+    /// Constant velocity, Eq. (11).
+    Cv,
+    /// Constant acceleration, Eq. (12).
+    Ca,
+    /// The learned motion prior (§5.1, `sillage fit motion-prior`).
+    Mp,
+}
+
+impl ModelName {
+    /// Every model, in the paper's order.
+    pub const ALL: [ModelName; 4] = [Self::Cp, Self::Cv, Self::Ca, Self::Mp];
+
+    /// The paper's abbreviation (`CP`, `CV`, `CA`, `MP`).
+    pub const fn label(self) -> &'static str {
+        match self {
+            Self::Cp => "CP",
+            Self::Cv => "CV",
+            Self::Ca => "CA",
+            Self::Mp => "MP",
+        }
+    }
+
+    /// Parses a combination written as the paper's tables do (`CV_CA_MP`, any case, `_`,
+    /// `+` or `,` between names).
+    pub fn parse_combination(text: &str) -> Result<Vec<ModelName>> {
+        let mut models = Vec::new();
+        for part in text.split(['_', '+', ',']).filter(|p| !p.is_empty()) {
+            let model = Self::ALL
+                .into_iter()
+                .find(|m| m.label().eq_ignore_ascii_case(part.trim()))
+                .ok_or_else(|| {
+                    Error::parameter(
+                        "models",
+                        text,
+                        format!("`{part}` is not a model; use CP, CV, CA or MP, e.g. CV_CA_MP"),
+                    )
+                })?;
+            if models.contains(&model) {
+                return Err(Error::parameter("models", text, "names a model twice"));
+            }
+            models.push(model);
+        }
+        if models.is_empty() {
+            return Err(Error::parameter(
+                "models",
+                text,
+                "names no model; e.g. CV_CA",
+            ));
+        }
+        Ok(models)
+    }
+
+    /// The combination's name as in the paper's tables (`CV_CA_MP`).
+    pub fn combination_label(models: &[ModelName]) -> String {
+        models
+            .iter()
+            .map(|m| m.label())
+            .collect::<Vec<_>>()
+            .join("_")
+    }
+}
+
+/// How a tracker is scored against detections when there are no images (the detections-only
+/// mode) — and how detections are matched to trackers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DetectionLikelihoodParams {
+    /// A detection is matched to the tracker whose predicted box it overlaps most, when the
+    /// IoU reaches this; default 0.3.
+    pub match_iou: f64,
+    /// σ of the Gaussian of the foot-point distance, as a fraction of the detection's
+    /// height; default 0.1.
+    pub foot_sigma_fraction: f64,
+    /// `ln p(Z | X)` of every particle of a tracker with no matched detection; default
+    /// ln 0.01.
+    pub missed_log_likelihood: f64,
+    /// Detections below this score are ignored; default −∞ (keep all).
+    pub min_score: f64,
+    /// Weight of a matched detection's size in the tracker's box size (exponential
+    /// smoothing); default 0.3.
+    pub size_smoothing: f64,
+}
+
+impl Default for DetectionLikelihoodParams {
+    fn default() -> Self {
+        Self {
+            match_iou: 0.3,
+            foot_sigma_fraction: 0.1,
+            missed_log_likelihood: 0.01f64.ln(),
+            min_score: f64::NEG_INFINITY,
+            size_smoothing: 0.3,
+        }
+    }
+}
+
+/// Parameters of the pedestrian tracker: the filter, the competing models and their
+/// noises, the observation model and the life cycle of trackers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PedestrianParams {
+    /// The IMM particle filter (N = 200, ρ = 4, φ = 5, γ = 0.1·N).
+    pub filter: ImmPfParams,
+    /// The competing models; default CV_CA (the paper's combination of two linear models).
+    pub models: Vec<ModelName>,
+    /// σ of the position noise of every model, px per frame; default 3.
+    pub pos_noise_px: f64,
+    /// σ of the velocity noise (CV, CA), px/frame per frame; default 1.
+    pub vel_noise_px_per_frame: f64,
+    /// σ of the acceleration noise (CA), px/frame² per frame; default 0.3.
+    pub acc_noise_px_per_frame2: f64,
+    /// σ of the initial positions around the birth foot point, px; default 3.
+    pub init_pos_noise_px: f64,
+    /// σ of the initial velocities around zero, px/frame; default 2.
+    pub init_vel_noise_px_per_frame: f64,
+    /// The colour and motion likelihood (images).
+    pub appearance: AppearanceParams,
+    /// The detection likelihood (detections only).
+    pub detection: DetectionLikelihoodParams,
+    /// A tracker dies after its mean particle likelihood stays below `exp` of this for
+    /// `death_frames` frames (§5.3); default −14 (chosen on PETS 2009 S2.L1 among −14 to −26,
+    /// docs/immpf.md; a person well followed scores −2 to −8, a box that lost its person
+    /// below −15). In the detections-only mode the missed likelihood (ln 0.01 ≈ −4.6) is
+    /// above it: there a tracker dies by `unsupported_frames`.
+    pub death_log_likelihood: f64,
+    /// Consecutive frames below the threshold before a tracker dies; default 3.
+    pub death_frames: u32,
+    /// A tracker that no candidate (motion blob or detection) supports — none
+    /// holds its foot point or overlaps its box — for this many frames in a row dies; default
+    /// 7 (1 s at PETS 2009's 7 frames/s). Not in the paper, whose only death rule is the
+    /// likelihood's: a tracker born on a spurious blob keeps matching the background it was
+    /// born on. Set it high to follow people who stand still for long.
+    pub unsupported_frames: u32,
+    /// Image mode: a person is born only where at least this share of its box's pixels moved
+    /// since the previous frame (frame difference beyond the first motion bin); default 0.1
+    /// (walkers in PETS 2009 move 17 % or more of their box at 7 frames/s, the background
+    /// subtraction's ghosts and flicker 1-7 %). 0 accepts every candidate.
+    pub birth_min_motion: f64,
+    /// A tracker is reported once it has lived this many frames, its first frames then
+    /// reported at once; one that dies younger is never reported (SORT's `min_hits`); default
+    /// 3. 1 reports every tracker from its birth.
+    pub confirm_frames: u32,
+    /// A birth candidate (motion blob or detection) is explained by a tracker whose box it
+    /// overlaps by at least this IoU; default 0.2.
+    pub birth_overlap: f64,
+    /// Two trackers whose boxes overlap by at least this IoU follow one person: the younger
+    /// dies; default 0.5.
+    pub duplicate_overlap: f64,
+}
+
+impl Default for PedestrianParams {
+    fn default() -> Self {
+        Self {
+            filter: ImmPfParams::default(),
+            models: vec![ModelName::Cv, ModelName::Ca],
+            pos_noise_px: 3.0,
+            vel_noise_px_per_frame: 1.0,
+            acc_noise_px_per_frame2: 0.3,
+            init_pos_noise_px: 3.0,
+            init_vel_noise_px_per_frame: 2.0,
+            appearance: AppearanceParams::default(),
+            detection: DetectionLikelihoodParams::default(),
+            death_log_likelihood: -14.0,
+            death_frames: 3,
+            unsupported_frames: 7,
+            birth_min_motion: 0.1,
+            confirm_frames: 3,
+            birth_overlap: 0.2,
+            duplicate_overlap: 0.5,
+        }
+    }
+}
+
+impl PedestrianParams {
+    /// Checks every value; errors name the key.
+    pub fn validate(&self) -> Result<()> {
+        if self.models.is_empty() {
+            return Err(Error::parameter(
+                "models",
+                "[]",
+                "must list at least one model",
+            ));
+        }
+        for (key, value) in [
+            ("pos_noise_px", self.pos_noise_px),
+            ("vel_noise_px_per_frame", self.vel_noise_px_per_frame),
+            ("acc_noise_px_per_frame2", self.acc_noise_px_per_frame2),
+            ("init_pos_noise_px", self.init_pos_noise_px),
+            (
+                "init_vel_noise_px_per_frame",
+                self.init_vel_noise_px_per_frame,
+            ),
+            (
+                "detection.foot_sigma_fraction",
+                self.detection.foot_sigma_fraction,
+            ),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Error::parameter(key, value, "must be a finite σ ≥ 0"));
+            }
+        }
+        for (key, value) in [
+            ("birth_overlap", self.birth_overlap),
+            ("birth_min_motion", self.birth_min_motion),
+            ("duplicate_overlap", self.duplicate_overlap),
+            ("detection.match_iou", self.detection.match_iou),
+            ("detection.size_smoothing", self.detection.size_smoothing),
+        ] {
+            if !(0.0..=1.0).contains(&value) {
+                return Err(Error::parameter(key, value, "must be in [0, 1]"));
+            }
+        }
+        for (key, value) in [
+            ("death_log_likelihood", self.death_log_likelihood),
+            (
+                "detection.missed_log_likelihood",
+                self.detection.missed_log_likelihood,
+            ),
+        ] {
+            if !value.is_finite() {
+                return Err(Error::parameter(
+                    key,
+                    value,
+                    "must be a finite log-likelihood",
+                ));
+            }
+        }
+        for (key, frames) in [
+            ("death_frames", self.death_frames),
+            ("unsupported_frames", self.unsupported_frames),
+            ("confirm_frames", self.confirm_frames),
+        ] {
+            if frames == 0 {
+                return Err(Error::parameter(key, 0, "must be ≥ 1 frame"));
+            }
+        }
+        self.appearance.validate()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn combinations_parse_as_the_paper_writes_them() {
+        let models = ModelName::parse_combination("cv_CA_Mp").unwrap();
+        assert_eq!(models, [ModelName::Cv, ModelName::Ca, ModelName::Mp]);
+        assert_eq!(ModelName::combination_label(&models), "CV_CA_MP");
+        let err = ModelName::parse_combination("CV_XX")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("XX"), "{err}");
+        assert!(ModelName::parse_combination("CV_CV").is_err());
+        assert!(PedestrianParams::default().validate().is_ok());
+    }
+}

@@ -1,0 +1,414 @@
+//! The multi-pedestrian tracker of the IMM-PF paper: one IMM particle filter per person
+//! (§4), born on motion blobs or detections that no tracker explains, scored by colour and
+//! motion histograms (§4.3) or, without images, by the detections, and removed when the mean
+//! likelihood of its particles stays low for some frames (§5.3).
+
+use rayon::prelude::*;
+use sillage_core::{Error, FrameIndex, Point2, Result, TrackId, Vec2};
+use sillage_filter::{
+    CompetingMotion, ImmParticleFilter, ImmPfSpec, InitialSpread, KinematicModel, Noise2,
+    linear_model,
+};
+
+use super::appearance::{Appearance, FrameCues, HistogramScratch};
+use super::models::PedestrianMotion;
+use super::params::{ModelName, PedestrianParams};
+use super::person_box::PersonBox;
+use super::sizing::BoxSizing;
+
+/// A box that may start a tracker: a motion blob or a detection, with its score (1 for
+/// blobs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// The box, px.
+    pub bbox: PersonBox,
+    /// Detector score (larger is surer).
+    pub score: f64,
+}
+
+/// What the tracker sees of one frame.
+#[derive(Debug, Clone, Copy)]
+pub struct PedestrianFrame<'a> {
+    /// 0-based frame index, increasing.
+    pub frame: FrameIndex,
+    /// Colour and motion bins of the frame; `None` in the detections-only mode, where the
+    /// candidates also score the particles.
+    pub cues: Option<&'a FrameCues>,
+    /// Motion blobs or detections of the frame.
+    pub candidates: &'a [Candidate],
+}
+
+/// One person's estimate in one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PedestrianEstimate {
+    /// Frame.
+    pub frame: FrameIndex,
+    /// Tracker identity.
+    pub track_id: TrackId,
+    /// The box on the posterior mean foot point.
+    pub bbox: PersonBox,
+    /// Posterior mean velocity of the foot point, px/frame.
+    pub vel_px_per_frame: Vec2,
+    /// πₘ, the weight of each model, in the order of `PedestrianParams::models`.
+    pub model_weights: Vec<f64>,
+}
+
+/// Least IoU of a candidate with a tracker's box for it to support the tracker.
+const SUPPORT_IOU: f64 = 0.1;
+
+/// One live tracker.
+#[derive(Debug, Clone)]
+struct Track {
+    filter: ImmParticleFilter,
+    appearance: Option<Appearance>,
+    /// Width and height, px, used where the sizing has no ground plane.
+    size_px: (f64, f64),
+    low_frames: u32,
+    /// Consecutive frames without a candidate on the tracker's box.
+    unsupported_frames: u32,
+    /// The detection matched this frame (detections-only mode).
+    matched: Option<PersonBox>,
+    bbox: PersonBox,
+    /// Frames lived, the birth frame included.
+    age: u32,
+    /// Estimates held until the tracker is confirmed (`confirm_frames`).
+    held: Vec<PedestrianEstimate>,
+}
+
+/// The pedestrian IMM-PF tracker. Each filter draws from its own stream
+/// `rng_stream(seed, track_id)`, and trackers are stepped in parallel: results are the same
+/// for any number of threads.
+#[derive(Debug)]
+pub struct PedestrianTracker {
+    params: PedestrianParams,
+    spec: ImmPfSpec,
+    models: Vec<PedestrianMotion>,
+    sizing: BoxSizing,
+    frame_size_px: (usize, usize),
+    tracks: Vec<Track>,
+    next_id: TrackId,
+    last_frame: Option<FrameIndex>,
+}
+
+impl PedestrianTracker {
+    /// A tracker for frames of `frame_size_px` (width, height); `prior` is the learned
+    /// motion prior, required when the models include MP. Parameters are validated here.
+    pub fn new(
+        params: &PedestrianParams,
+        sizing: BoxSizing,
+        prior: Option<&sillage_filter::MotionPrior>,
+        frame_size_px: (usize, usize),
+        seed: u64,
+    ) -> Result<Self> {
+        params.validate()?;
+        let spec = ImmPfSpec::new(&params.filter, params.models.len(), seed)?;
+        let models = params
+            .models
+            .iter()
+            .map(|&name| PedestrianMotion::new(name, params, prior))
+            .collect::<Result<_>>()?;
+        Ok(Self {
+            params: params.clone(),
+            spec,
+            models,
+            sizing,
+            frame_size_px,
+            tracks: Vec::new(),
+            next_id: 1,
+            last_frame: None,
+        })
+    }
+
+    /// The live trackers.
+    pub fn len(&self) -> usize {
+        self.tracks.len()
+    }
+
+    /// True when no tracker is alive.
+    pub fn is_empty(&self) -> bool {
+        self.tracks.is_empty()
+    }
+
+    /// Tracks one frame and appends to `out` the estimate of every confirmed tracker, preceded
+    /// by the held estimates of earlier frames of those confirmed at this frame.
+    pub fn step(
+        &mut self,
+        frame: &PedestrianFrame<'_>,
+        out: &mut Vec<PedestrianEstimate>,
+    ) -> Result<()> {
+        if self.last_frame.is_some_and(|last| frame.frame <= last) {
+            return Err(Error::input(format!(
+                "frame {} comes after frame {}: frames must come in increasing order",
+                frame.frame,
+                self.last_frame.unwrap_or_default()
+            )));
+        }
+        self.last_frame = Some(frame.frame);
+        let candidates: Vec<Candidate> = frame
+            .candidates
+            .iter()
+            .filter(|c| c.bbox.is_valid() && c.score >= self.params.detection.min_score)
+            .copied()
+            .collect();
+        self.predict_and_correct(frame.cues, &candidates);
+        self.count_support(&candidates);
+        self.bury();
+        self.give_birth(frame.cues, &candidates);
+        let confirm = self.params.confirm_frames;
+        let models = self.models.len();
+        for track in &mut self.tracks {
+            track.age += 1;
+            let estimate = estimate_of(track, frame.frame, models);
+            if track.age < confirm {
+                track.held.push(estimate);
+            } else {
+                out.append(&mut track.held);
+                out.push(estimate);
+            }
+        }
+        Ok(())
+    }
+
+    /// Prediction, weighting and resampling of every tracker, in parallel.
+    fn predict_and_correct(&mut self, cues: Option<&FrameCues>, candidates: &[Candidate]) {
+        let models = &self.models;
+        self.tracks
+            .par_iter_mut()
+            .for_each(|track| track.filter.predict(models));
+        if cues.is_none() {
+            self.match_detections(candidates);
+        }
+        let (params, sizing) = (&self.params, &self.sizing);
+        let death = params.death_log_likelihood.exp();
+        self.tracks
+            .par_iter_mut()
+            .for_each_init(HistogramScratch::default, |scratch, track| {
+                let size = track.size_px;
+                let weighting = match (cues, &track.appearance, track.matched) {
+                    (Some(cues), Some(appearance), _) => track.filter.weight(|p| {
+                        let b = sizing.box_at(p.pos_px, size);
+                        appearance.log_likelihood(&params.appearance, cues, &b, scratch)
+                    }),
+                    (None, _, Some(detection)) => {
+                        let foot = detection.foot();
+                        let sigma =
+                            (params.detection.foot_sigma_fraction * detection.height_px).max(1.0);
+                        let scale = 0.5 / (sigma * sigma);
+                        track
+                            .filter
+                            .weight(|p| -scale * (p.pos_px - foot).norm_squared())
+                    }
+                    _ => {
+                        let missed = params.detection.missed_log_likelihood;
+                        track.filter.weight(|_| missed)
+                    }
+                };
+                track.filter.resample();
+                if weighting.mean_likelihood < death {
+                    track.low_frames += 1;
+                } else {
+                    track.low_frames = 0;
+                }
+                let foot = estimate_foot(&track.filter);
+                track.bbox = sizing.box_at(foot, track.size_px);
+            });
+    }
+
+    /// Detections-only mode: each detection goes to the tracker whose predicted box it
+    /// overlaps most (greedy by IoU, at least `match_iou`); a matched tracker's size follows
+    /// its detections.
+    fn match_detections(&mut self, candidates: &[Candidate]) {
+        let predicted: Vec<PersonBox> = self
+            .tracks
+            .iter()
+            .map(|t| self.sizing.box_at(estimate_foot(&t.filter), t.size_px))
+            .collect();
+        let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+        for (t, p) in predicted.iter().enumerate() {
+            for (d, c) in candidates.iter().enumerate() {
+                let iou = p.iou(&c.bbox);
+                if iou >= self.params.detection.match_iou {
+                    pairs.push((iou, t, d));
+                }
+            }
+        }
+        pairs.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+        let mut track_used = vec![false; self.tracks.len()];
+        let mut detection_used = vec![false; candidates.len()];
+        self.tracks.iter_mut().for_each(|t| t.matched = None);
+        let alpha = self.params.detection.size_smoothing;
+        for (_, t, d) in pairs {
+            if track_used[t] || detection_used[d] {
+                continue;
+            }
+            track_used[t] = true;
+            detection_used[d] = true;
+            let detection = candidates[d].bbox;
+            let track = &mut self.tracks[t];
+            track.matched = Some(detection);
+            track.size_px = (
+                (1.0 - alpha) * track.size_px.0 + alpha * detection.width_px,
+                (1.0 - alpha) * track.size_px.1 + alpha * detection.height_px,
+            );
+        }
+    }
+
+    /// Counts the frames in a row where no candidate (motion blob or detection) holds a
+    /// tracker's foot point or overlaps its box.
+    fn count_support(&mut self, candidates: &[Candidate]) {
+        for track in &mut self.tracks {
+            let foot = track.bbox.foot();
+            let supported = candidates.iter().any(|c| {
+                let b = &c.bbox;
+                let holds_foot = foot.x >= b.left_px
+                    && foot.x <= b.right_px()
+                    && foot.y >= b.top_px
+                    && foot.y <= b.bottom_px() + 0.25 * track.bbox.height_px;
+                holds_foot || b.iou(&track.bbox) >= SUPPORT_IOU
+            });
+            track.unsupported_frames = if supported {
+                0
+            } else {
+                track.unsupported_frames + 1
+            };
+        }
+    }
+
+    /// Removes the trackers whose likelihood stayed low for `death_frames` frames, that no
+    /// candidate supported for `unsupported_frames` frames, whose foot left the image, and
+    /// the younger of two that follow one person.
+    fn bury(&mut self) {
+        let unsupported = self.params.unsupported_frames;
+        let (width, height) = (self.frame_size_px.0 as f64, self.frame_size_px.1 as f64);
+        let death_frames = self.params.death_frames;
+        self.tracks.retain(|t| {
+            let foot = t.bbox.foot();
+            t.low_frames < death_frames
+                && t.unsupported_frames < unsupported
+                && foot.x >= 0.0
+                && foot.x < width
+                && foot.y >= 0.0
+                && foot.y < height + t.bbox.height_px / 2.0
+        });
+        // Tracks are in birth order: a later one overlapping an earlier one is the duplicate.
+        let mut keep = vec![true; self.tracks.len()];
+        for later in 1..self.tracks.len() {
+            for earlier in 0..later {
+                if keep[earlier]
+                    && self.tracks[later].bbox.iou(&self.tracks[earlier].bbox)
+                        >= self.params.duplicate_overlap
+                {
+                    keep[later] = false;
+                    break;
+                }
+            }
+        }
+        let mut flags = keep.into_iter();
+        self.tracks.retain(|_| flags.next().unwrap_or(true));
+    }
+
+    /// Starts a tracker on every candidate that no live tracker explains.
+    fn give_birth(&mut self, cues: Option<&FrameCues>, candidates: &[Candidate]) {
+        let init_pos = self.params.init_pos_noise_px.powi(2);
+        let init_vel = self.params.init_vel_noise_px_per_frame.powi(2);
+        for candidate in candidates {
+            let explained = self.tracks.iter().any(|t| {
+                t.matched == Some(candidate.bbox)
+                    || t.bbox.iou(&candidate.bbox) >= self.params.birth_overlap
+            });
+            if explained {
+                continue;
+            }
+            for person in self.sizing.people_in(&candidate.bbox) {
+                let foot = person.foot();
+                if self.tracks.iter().any(|t| {
+                    t.bbox.iou(&person) >= self.params.birth_overlap || t.bbox.contains(foot)
+                }) {
+                    continue;
+                }
+                let appearance = match cues {
+                    Some(cues) => {
+                        match Appearance::capture(&self.params.appearance, cues, &person) {
+                            Some(appearance)
+                                if appearance.moving_share().unwrap_or(0.0)
+                                    >= self.params.birth_min_motion =>
+                            {
+                                Some(appearance)
+                            }
+                            _ => continue,
+                        }
+                    }
+                    None => None,
+                };
+                let spread = InitialSpread {
+                    pos_px: person.foot(),
+                    pos_noise: Noise2::diagonal(init_pos, init_pos)
+                        .factor("init_pos_noise_px")
+                        .expect("validated σ"),
+                    vel_px_per_frame: Vec2::new(0.0, 0.0),
+                    vel_noise: Noise2::diagonal(init_vel, init_vel)
+                        .factor("init_vel_noise_px_per_frame")
+                        .expect("validated σ"),
+                    mode: 0,
+                };
+                let filter = self.spec.spawn(self.next_id, &spread);
+                self.next_id += 1;
+                self.tracks.push(Track {
+                    filter,
+                    appearance,
+                    size_px: (person.width_px, person.height_px),
+                    low_frames: 0,
+                    unsupported_frames: 0,
+                    matched: None,
+                    bbox: person,
+                    age: 0,
+                    held: Vec::new(),
+                });
+            }
+        }
+    }
+}
+
+/// A tracker's estimate in `frame`.
+fn estimate_of(track: &Track, frame: FrameIndex, models: usize) -> PedestrianEstimate {
+    let mut model_weights = vec![0.0; models];
+    track.filter.model_weights(&mut model_weights);
+    let mean = track.filter.estimate().mean;
+    PedestrianEstimate {
+        frame,
+        track_id: track.filter.track_id(),
+        bbox: track.bbox,
+        vel_px_per_frame: Vec2::new(mean.at(2), mean.at(3)),
+        model_weights,
+    }
+}
+
+/// The posterior mean foot point.
+fn estimate_foot(filter: &ImmParticleFilter) -> Point2 {
+    let mean = filter.estimate().mean;
+    Point2::new(mean.at(0), mean.at(1))
+}
+
+/// The linear model `name` with the tracker's noises (Eqs. (10)-(12)).
+pub(super) fn kinematic(name: ModelName, params: &PedestrianParams) -> Result<KinematicModel> {
+    let label = name.label().to_ascii_lowercase();
+    let model = linear_model(
+        &label,
+        params.pos_noise_px,
+        params.vel_noise_px_per_frame,
+        params.acc_noise_px_per_frame2,
+    )
+    .ok_or_else(|| Error::parameter("models", name.label(), "is not a linear model"))?;
+    KinematicModel::new(&format!("models.{label}"), &model)
+}
+
+impl CompetingMotion for PedestrianMotion {
+    fn advance(
+        &self,
+        columns: &mut sillage_filter::Columns<'_>,
+        i: usize,
+        normals: &mut sillage_filter::Normals<'_>,
+    ) {
+        self.advance_particle(columns, i, normals);
+    }
+}
