@@ -153,6 +153,11 @@ pub struct PedestrianParams {
     /// reported at once; one that dies younger is never reported (SORT's `min_hits`); default
     /// 3. 1 reports every tracker from its birth.
     pub confirm_frames: u32,
+    /// A person born within this many frames of the death of a confirmed tracker, where
+    /// that tracker was heading (its last foot point moved on at its last velocity, within
+    /// half a box height), takes the dead tracker's identity back; default 10 (not in the
+    /// paper: it reduces the identities a person lost in a crowd receives). 0 disables it.
+    pub revive_frames: u32,
     /// A birth candidate (motion blob or detection) is explained by a tracker whose box it
     /// overlaps by at least this IoU; default 0.2.
     pub birth_overlap: f64,
@@ -178,6 +183,7 @@ impl Default for PedestrianParams {
             unsupported_frames: 7,
             birth_min_motion: 0.1,
             confirm_frames: 3,
+            revive_frames: 10,
             birth_overlap: 0.2,
             duplicate_overlap: 0.5,
         }

@@ -86,8 +86,21 @@ pub struct PedestrianTracker {
     sizing: BoxSizing,
     frame_size_px: (usize, usize),
     tracks: Vec<Track>,
+    /// Confirmed trackers that died in the last `revive_frames` frames.
+    departed: Vec<Departed>,
     next_id: TrackId,
     last_frame: Option<FrameIndex>,
+}
+
+/// A confirmed tracker that died recently: where it was going, so that a birth on its way
+/// takes its identity back.
+#[derive(Debug, Clone, Copy)]
+struct Departed {
+    track_id: TrackId,
+    foot: Point2,
+    vel_px_per_frame: Vec2,
+    /// Its last frame.
+    frame: FrameIndex,
 }
 
 impl PedestrianTracker {
@@ -114,6 +127,7 @@ impl PedestrianTracker {
             sizing,
             frame_size_px,
             tracks: Vec::new(),
+            departed: Vec::new(),
             next_id: 1,
             last_frame: None,
         })
@@ -152,8 +166,8 @@ impl PedestrianTracker {
             .collect();
         self.predict_and_correct(frame.cues, &candidates);
         self.count_support(&candidates);
-        self.bury();
-        self.give_birth(frame.cues, &candidates);
+        self.bury(frame.frame);
+        self.give_birth(frame.frame, frame.cues, &candidates);
         let confirm = self.params.confirm_frames;
         let models = self.models.len();
         for track in &mut self.tracks {
@@ -277,18 +291,30 @@ impl PedestrianTracker {
     /// Removes the trackers whose likelihood stayed low for `death_frames` frames, that no
     /// candidate supported for `unsupported_frames` frames, whose foot left the image, and
     /// the younger of two that follow one person.
-    fn bury(&mut self) {
+    fn bury(&mut self, frame: FrameIndex) {
         let unsupported = self.params.unsupported_frames;
         let (width, height) = (self.frame_size_px.0 as f64, self.frame_size_px.1 as f64);
         let death_frames = self.params.death_frames;
+        let (confirm, revive) = (self.params.confirm_frames, self.params.revive_frames);
+        let departed = &mut self.departed;
+        departed.retain(|d| frame - d.frame <= u64::from(revive));
         self.tracks.retain(|t| {
             let foot = t.bbox.foot();
-            t.low_frames < death_frames
-                && t.unsupported_frames < unsupported
-                && foot.x >= 0.0
+            let inside = foot.x >= 0.0
                 && foot.x < width
                 && foot.y >= 0.0
-                && foot.y < height + t.bbox.height_px / 2.0
+                && foot.y < height + t.bbox.height_px / 2.0;
+            let alive = t.low_frames < death_frames && t.unsupported_frames < unsupported;
+            if inside && !alive && t.age >= confirm && revive > 0 {
+                let mean = t.filter.estimate().mean;
+                departed.push(Departed {
+                    track_id: t.filter.track_id(),
+                    foot,
+                    vel_px_per_frame: Vec2::new(mean.at(2), mean.at(3)),
+                    frame,
+                });
+            }
+            inside && alive
         });
         // Tracks are in birth order: a later one overlapping an earlier one is the duplicate.
         let mut keep = vec![true; self.tracks.len()];
@@ -308,7 +334,12 @@ impl PedestrianTracker {
     }
 
     /// Starts a tracker on every candidate that no live tracker explains.
-    fn give_birth(&mut self, cues: Option<&FrameCues>, candidates: &[Candidate]) {
+    fn give_birth(
+        &mut self,
+        frame: FrameIndex,
+        cues: Option<&FrameCues>,
+        candidates: &[Candidate],
+    ) {
         let init_pos = self.params.init_pos_noise_px.powi(2);
         let init_vel = self.params.init_vel_noise_px_per_frame.powi(2);
         for candidate in candidates {
@@ -351,21 +382,47 @@ impl PedestrianTracker {
                         .expect("validated σ"),
                     mode: 0,
                 };
-                let filter = self.spec.spawn(self.next_id, &spread);
-                self.next_id += 1;
+                let (track_id, age) = match self.revive(frame, &person) {
+                    Some(track_id) => (track_id, self.params.confirm_frames),
+                    None => {
+                        self.next_id += 1;
+                        (self.next_id - 1, 0)
+                    }
+                };
                 self.tracks.push(Track {
-                    filter,
+                    filter: self.spec.spawn(track_id, &spread),
                     appearance,
                     size_px: (person.width_px, person.height_px),
                     low_frames: 0,
                     unsupported_frames: 0,
                     matched: None,
                     bbox: person,
-                    age: 0,
+                    age,
                     held: Vec::new(),
                 });
             }
         }
+    }
+}
+
+impl PedestrianTracker {
+    /// The identity of the departed tracker whose extrapolated foot point is nearest to
+    /// `person`'s, within half its height; removed from the departed.
+    fn revive(&mut self, frame: FrameIndex, person: &PersonBox) -> Option<TrackId> {
+        let foot = person.foot();
+        let gate = 0.5 * person.height_px;
+        let (k, _) = self
+            .departed
+            .iter()
+            .enumerate()
+            .map(|(k, d)| {
+                let elapsed = (frame - d.frame) as f64;
+                let predicted = d.foot + d.vel_px_per_frame * elapsed;
+                (k, (predicted - foot).norm())
+            })
+            .filter(|&(_, distance)| distance <= gate)
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        Some(self.departed.swap_remove(k).track_id)
     }
 }
 
