@@ -75,6 +75,7 @@ pub fn run(args: &BenchImmpfArgs) -> Result<()> {
         models: None,
         out: PathBuf::new(),
         model_weights: None,
+        overlay: None,
         config: args.config.clone(),
         overrides: args.overrides.clone(),
         seed: 1,
@@ -159,6 +160,7 @@ fn prepare(
         motion,
         &params.appearance,
         args.max_frames,
+        false,
     )?;
     let mut frames = Vec::new();
     while let Some(frame) = input.next_frame()? {

@@ -709,6 +709,11 @@ pub struct TrackImmpfArgs {
     /// Also write `frame,id,<model weights>` for every result row.
     #[arg(long, value_name = "FILE")]
     pub model_weights: Option<PathBuf>,
+    /// Also draw every frame with each person's box, the bar of its model weights and its
+    /// trajectory coloured by the dominant model (CP red, CV green, CA blue, MP magenta) into
+    /// this folder, as `overlay_NNNNN.png` (1-based frame number).
+    #[arg(long, value_name = "DIR", requires = "input")]
+    pub overlay: Option<PathBuf>,
     /// TOML parameters: `[tracker]` (filter, models, noises, appearance, detection, death,
     /// births) and `[motion_detector]`.
     #[arg(long, value_name = "FILE")]

@@ -1,14 +1,19 @@
 //! `--overlay DIR`: one PNG per frame with the frame's detections circled and the track
 //! tails coloured by motion state, with ids (resting blue, rolling orange, saltating
-//! vermillion, unknown grey) — for looking at what a tracker did.
+//! vermillion, unknown grey) — for looking at what a tracker did; and the pedestrian
+//! overlays of `sillage track immpf --overlay DIR` (boxes, model-weight bars, trajectories
+//! coloured by the dominant model).
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use sillage::core::{Detection, FrameIndex, TrackPoint};
 use sillage::io::{FrameOptions, open_frames, write_png_rgb};
-use sillage::viz::{OverlayStyle, TrackHistory, draw_overlay};
+use sillage::track::immpf::{ModelName, PedestrianEstimate};
+use sillage::viz::{
+    OverlayStyle, PedestrianTrails, PersonOverlay, TrackHistory, draw_overlay, draw_pedestrians,
+};
 
 use crate::progress::FrameProgress;
 
@@ -46,4 +51,64 @@ pub fn write_overlays(
     }
     progress.finish();
     Ok(written)
+}
+
+/// `sillage track immpf --overlay DIR`: draws each frame as the tracker goes, from the
+/// estimates of that frame (those reported late, at a track's confirmation, only join the
+/// trajectories), into `DIR/overlay_NNNNN.png` (1-based frame number).
+pub struct PedestrianOverlays {
+    dir: PathBuf,
+    models: Vec<&'static str>,
+    trails: PedestrianTrails,
+    people: Vec<PersonOverlay>,
+}
+
+impl PedestrianOverlays {
+    /// Creates `dir` for the overlays of a tracker with `models`.
+    pub fn create(dir: &Path, models: &[ModelName]) -> Result<Self> {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            models: models.iter().map(|m| m.label()).collect(),
+            trails: PedestrianTrails::default(),
+            people: Vec::new(),
+        })
+    }
+
+    /// Adds the `estimates` of a step to the trajectories and draws `prepared`'s frame with
+    /// the people estimated at that frame.
+    pub fn push(
+        &mut self,
+        prepared: &crate::pedestrian_input::PreparedFrame,
+        estimates: &[PedestrianEstimate],
+    ) -> Result<()> {
+        let colour = prepared
+            .colour
+            .as_ref()
+            .context("overlays need the colour frames")?;
+        self.people.clear();
+        for e in estimates {
+            let person = PersonOverlay {
+                track_id: e.track_id,
+                left_px: e.bbox.left_px,
+                top_px: e.bbox.top_px,
+                width_px: e.bbox.width_px,
+                height_px: e.bbox.height_px,
+                model_weights: e.model_weights.clone(),
+            };
+            self.trails.record(e.frame, &person);
+            if e.frame == prepared.frame {
+                self.people.push(person);
+            }
+        }
+        let picture = draw_pedestrians(colour, &self.people, &self.trails, &self.models)
+            .with_context(|| format!("overlay of frame {}", prepared.frame + 1))?;
+        write_png_rgb(
+            self.dir
+                .join(format!("overlay_{:05}.png", prepared.frame + 1)),
+            &picture,
+        )?;
+        Ok(())
+    }
 }

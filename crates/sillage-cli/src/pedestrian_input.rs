@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
-use sillage::core::FrameIndex;
+use sillage::core::{FrameIndex, RgbImage};
 use sillage::detect::motion::{MotionBlob, MotionDetector, MotionParams};
 use sillage::io::read_mot_rows;
 use sillage::io::{FrameOptions, FrameSource, open_frames};
@@ -20,6 +20,8 @@ pub struct PreparedFrame {
     pub cues: Option<FrameCues>,
     /// Birth candidates (and, without cues, the measurements).
     pub candidates: Vec<Candidate>,
+    /// The colour frame, kept only when asked for (`keep_colour`, for overlays).
+    pub colour: Option<RgbImage>,
 }
 
 /// Where the frames and candidates come from.
@@ -29,6 +31,7 @@ pub struct PedestrianInput {
     motion: Option<MotionDetector>,
     appearance: AppearanceParams,
     cues: FrameCues,
+    keep_colour: bool,
     /// Frames in the detections-only mode: 0 to the last detection frame (or `frame_count`).
     next_frame: FrameIndex,
     end_frame: FrameIndex,
@@ -73,7 +76,8 @@ pub fn seqinfo_beside(file: &Path) -> Option<(PathBuf, sillage::io::SeqInfo)> {
 
 impl PedestrianInput {
     /// Colour frames of `input` (motion blobs as candidates unless `detections` is given),
-    /// or, without `input`, the detections alone over frames of `frame_size_px`.
+    /// or, without `input`, the detections alone over frames of `frame_size_px`;
+    /// `keep_colour` keeps each colour frame in [`PreparedFrame::colour`].
     pub fn open(
         input: Option<&str>,
         detections: Option<&Path>,
@@ -81,6 +85,7 @@ impl PedestrianInput {
         motion: &MotionParams,
         appearance: &AppearanceParams,
         max_frames: Option<usize>,
+        keep_colour: bool,
     ) -> Result<Self> {
         let detections = detections.map(read_candidates).transpose()?;
         let (frames, size, len, end) = match input {
@@ -124,6 +129,7 @@ impl PedestrianInput {
             motion,
             appearance: appearance.clone(),
             cues: FrameCues::default(),
+            keep_colour,
             next_frame: 0,
             end_frame: end,
             frame_size_px: size,
@@ -144,12 +150,13 @@ impl PedestrianInput {
                 frame,
                 cues: None,
                 candidates,
+                colour: None,
             }));
         };
         let Some(frame) = frames.next() else {
             return Ok(None);
         };
-        let frame = frame?;
+        let mut frame = frame?;
         let colour = frame
             .colour
             .as_ref()
@@ -176,6 +183,11 @@ impl PedestrianInput {
             frame: frame.index,
             cues: Some(self.cues.without_history()),
             candidates,
+            colour: if self.keep_colour {
+                frame.colour.take()
+            } else {
+                None
+            },
         }))
     }
 

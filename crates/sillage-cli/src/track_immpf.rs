@@ -18,6 +18,7 @@ use sillage::track::immpf::{
 
 use crate::cli::TrackImmpfArgs;
 use crate::ground_plane::GroundPlaneFile;
+use crate::overlay::PedestrianOverlays;
 use crate::pedestrian_input::{PedestrianInput, PreparedFrame, seqinfo_beside};
 use crate::progress::FrameProgress;
 
@@ -86,6 +87,7 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         &motion,
         &params.appearance,
         args.max_frames,
+        args.overlay.is_some(),
     )?;
     let mut tracker = PedestrianTracker::new(
         &params,
@@ -100,6 +102,11 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         .as_deref()
         .map(|path| ModelWeightsWriter::create(path, &params.models))
         .transpose()?;
+    let mut overlays = args
+        .overlay
+        .as_deref()
+        .map(|dir| PedestrianOverlays::create(dir, &params.models))
+        .transpose()?;
     let mut progress = FrameProgress::new(input.len, "tracking");
     let (mut frames, mut rows, mut last_id) = (0u64, 0u64, 0u64);
     let mut estimates = Vec::new();
@@ -113,6 +120,9 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         writer.push(&mot_rows(&estimates))?;
         if let Some(w) = &mut weights {
             w.push(&estimates)?;
+        }
+        if let Some(o) = &mut overlays {
+            o.push(&prepared, &estimates)?;
         }
         rows += estimates.len() as u64;
         last_id = estimates.iter().map(|e| e.track_id).fold(last_id, u64::max);

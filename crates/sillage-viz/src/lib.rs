@@ -3,7 +3,10 @@
 //! - [`Figure`] of [`GroupedChart`]s: categories along x, grouped bars on a left scale and
 //!   curves on a right scale — the MMPF+ paper's Fig. 6 and Fig. 7 — as PNG pixels or SVG;
 //! - [`draw_overlay`]: a frame with its detections circled and track tails coloured by motion
-//!   state, with ids, from a [`TrackHistory`].
+//!   state, with ids, from a [`TrackHistory`];
+//! - [`draw_pedestrians`]: tracked people's boxes with the bar of their motion-model weights
+//!   and their trajectories coloured by the dominant model (the IMM-PF paper's Fig. 1(b) and
+//!   Fig. 2), from [`PersonOverlay`]s and [`PedestrianTrails`].
 //!
 //! Text uses a built-in typeface (DejaVu Sans), so nothing depends on the system's fonts.
 //!
@@ -29,8 +32,10 @@ mod font;
 mod history;
 mod overlay;
 mod palette;
+mod pedestrians;
 
 pub use chart::{Figure, GroupedChart, Series, ValueAxis};
 pub use history::TrackHistory;
 pub use overlay::{OverlayStyle, draw_overlay};
-pub use palette::state_rgb;
+pub use palette::{model_rgb, state_rgb};
+pub use pedestrians::{PedestrianTrails, PersonOverlay, TrailPoint, draw_pedestrians};

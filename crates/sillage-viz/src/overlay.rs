@@ -63,7 +63,6 @@ pub fn draw_overlay(
     style: &OverlayStyle,
 ) -> Result<RgbImage> {
     style.validate()?;
-    ensure_registered()?;
     let (width, height) = frame.dimensions();
     let pixels = frame
         .as_slice()
@@ -75,13 +74,7 @@ pub fn draw_overlay(
         })
         .collect();
     let mut picture = RgbImage::from_vec(width, height, pixels)?;
-    let size = (
-        u32::try_from(width).map_err(drawing_error)?,
-        u32::try_from(height).map_err(drawing_error)?,
-    );
-    {
-        let backend = BitMapBackend::with_buffer(picture.as_mut_slice().as_flattened_mut(), size);
-        let area = backend.into_drawing_area();
+    draw_on(&mut picture, |area| {
         for detection in detections {
             let radius = style
                 .detection_radius_px
@@ -98,11 +91,31 @@ pub fn draw_overlay(
             area.draw(&circle).map_err(drawing_error)?;
         }
         for tail in tails {
-            draw_tail(&area, frame, tail, style.show_ids)?;
+            draw_tail(area, frame, tail, style.show_ids)?;
         }
-        area.present().map_err(drawing_error)?;
-    }
+        Ok(())
+    })?;
     Ok(picture)
+}
+
+/// The drawing area of overlays: `picture`'s own pixels, in pixel coordinates.
+pub(crate) type PixelArea<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// Runs `draw` on `picture`'s pixels (the built-in typeface registered, so text can be
+/// written) and presents the result into `picture`.
+pub(crate) fn draw_on(
+    picture: &mut RgbImage,
+    draw: impl FnOnce(&PixelArea<'_>) -> Result<()>,
+) -> Result<()> {
+    ensure_registered()?;
+    let size = (
+        u32::try_from(picture.width()).map_err(drawing_error)?,
+        u32::try_from(picture.height()).map_err(drawing_error)?,
+    );
+    let backend = BitMapBackend::with_buffer(picture.as_mut_slice().as_flattened_mut(), size);
+    let area = backend.into_drawing_area();
+    draw(&area)?;
+    area.present().map_err(drawing_error)
 }
 
 /// One track's tail (segments coloured by the state at their end), head and id.
@@ -142,7 +155,7 @@ fn draw_tail<DB: DrawingBackend>(
 }
 
 /// The nearest pixel to `p`, as plotters' integer coordinates.
-fn pixel(p: sillage_core::Point2) -> (i32, i32) {
+pub(crate) fn pixel(p: sillage_core::Point2) -> (i32, i32) {
     (p.x.round() as i32, p.y.round() as i32)
 }
 

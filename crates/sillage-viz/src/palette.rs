@@ -37,3 +37,20 @@ pub fn state_rgb(state: MotionState) -> [u8; 3] {
     let c = state_colour(state);
     [c.0, c.1, c.2]
 }
+
+/// The colour of a pedestrian motion model on overlays, as the IMM-PF paper draws them:
+/// `CP` (constant position) red, `CV` (constant velocity) green, `CA` (constant
+/// acceleration) blue, and `MP` (the learned motion prior) magenta; any other name takes the
+/// Okabe–Ito colour of its `position` in the list of models.
+pub fn model_rgb(name: &str, position: usize) -> [u8; 3] {
+    match name.to_ascii_uppercase().as_str() {
+        "CP" => [230, 25, 25],
+        "CV" => [20, 200, 40],
+        "CA" => [30, 90, 255],
+        "MP" => [235, 0, 235],
+        _ => {
+            let c = series_colour(position);
+            [c.0, c.1, c.2]
+        }
+    }
+}
