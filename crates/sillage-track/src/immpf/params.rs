@@ -93,6 +93,9 @@ pub struct DetectionLikelihoodParams {
     /// Weight of a matched detection's size in the tracker's box size (exponential
     /// smoothing); default 0.3.
     pub size_smoothing: f64,
+    /// Report a tracker on the frames where no detection matched it (its prediction);
+    /// default false: reported only when a detection confirms it, as SORT does.
+    pub report_coasting: bool,
 }
 
 impl Default for DetectionLikelihoodParams {
@@ -103,6 +106,7 @@ impl Default for DetectionLikelihoodParams {
             missed_log_likelihood: 0.01f64.ln(),
             min_score: f64::NEG_INFINITY,
             size_smoothing: 0.3,
+            report_coasting: false,
         }
     }
 }

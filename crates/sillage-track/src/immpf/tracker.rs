@@ -170,14 +170,21 @@ impl PedestrianTracker {
         self.give_birth(frame.frame, frame.cues, &candidates);
         let confirm = self.params.confirm_frames;
         let models = self.models.len();
+        // Detections only: a tracker is reported on the frames a detection confirms it (its
+        // birth or a match), as SORT does; it coasts unreported through missed detections.
+        let coasting_hidden = frame.cues.is_none() && !self.params.detection.report_coasting;
         for track in &mut self.tracks {
             track.age += 1;
-            let estimate = estimate_of(track, frame.frame, models);
+            let observed = track.age == 1 || track.matched.is_some();
             if track.age < confirm {
-                track.held.push(estimate);
+                if observed || !coasting_hidden {
+                    track.held.push(estimate_of(track, frame.frame, models));
+                }
             } else {
                 out.append(&mut track.held);
-                out.push(estimate);
+                if observed || !coasting_hidden {
+                    out.push(estimate_of(track, frame.frame, models));
+                }
             }
         }
         Ok(())
