@@ -158,8 +158,8 @@ pub struct PedestrianParams {
     /// 3. 1 reports every tracker from its birth.
     pub confirm_frames: u32,
     /// A person born within this many frames of the death of a confirmed tracker, where
-    /// that tracker was heading (its last foot point moved on at its last velocity, within
-    /// half a box height), takes the dead tracker's identity back; default 10 (not in the
+    /// that tracker was heading (its last foot point, or that point moved on at its last
+    /// velocity, within half a box height), takes the dead tracker's identity back; default 10 (not in the
     /// paper: it reduces the identities a person lost in a crowd receives). 0 disables it.
     pub revive_frames: u32,
     /// A birth candidate (motion blob or detection) is explained by a tracker whose box it

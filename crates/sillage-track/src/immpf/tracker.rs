@@ -413,8 +413,8 @@ impl PedestrianTracker {
 }
 
 impl PedestrianTracker {
-    /// The identity of the departed tracker whose extrapolated foot point is nearest to
-    /// `person`'s, within half its height; removed from the departed.
+    /// The identity of the departed tracker whose extrapolated (or last) foot point is
+    /// nearest to `person`'s, within half its height; removed from the departed.
     fn revive(&mut self, frame: FrameIndex, person: &PersonBox) -> Option<TrackId> {
         let foot = person.foot();
         let gate = 0.5 * person.height_px;
@@ -425,7 +425,9 @@ impl PedestrianTracker {
             .map(|(k, d)| {
                 let elapsed = (frame - d.frame) as f64;
                 let predicted = d.foot + d.vel_px_per_frame * elapsed;
-                (k, (predicted - foot).norm())
+                // The velocity of a tracker that was losing its person may be wrong: the
+                // last foot point counts as well.
+                (k, (predicted - foot).norm().min((d.foot - foot).norm()))
             })
             .filter(|&(_, distance)| distance <= gate)
             .min_by(|a, b| a.1.total_cmp(&b.1))?;
