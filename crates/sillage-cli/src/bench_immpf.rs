@@ -18,6 +18,7 @@ use sillage::track::immpf::{ModelName, PedestrianEstimate, PedestrianParams, Ped
 
 use crate::cli::{BenchImmpfArgs, MatchRule, TrackImmpfArgs};
 use crate::eval_inputs::load_truth;
+use crate::fit_pedestrian::median;
 use crate::pedestrian_input::{PedestrianInput, PreparedFrame, seqinfo_beside};
 use crate::track_immpf::{load_params, load_scene, step};
 
@@ -276,26 +277,21 @@ fn run_once(
 
 /// The median of each score over the runs.
 fn medians(runs: &[RunScores]) -> RunScores {
-    let median = |f: fn(&RunScores) -> f64| {
-        let mut v: Vec<f64> = runs.iter().map(f).collect();
-        v.sort_by(f64::total_cmp);
-        match v.len() {
-            0 => f64::NAN,
-            n if n % 2 == 1 => v[n / 2],
-            n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-        }
+    let of = |f: fn(&RunScores) -> f64| {
+        let mut values: Vec<f64> = runs.iter().map(f).collect();
+        median(&mut values).unwrap_or(f64::NAN)
     };
     RunScores {
-        sfda: median(|r| r.sfda),
-        ata: median(|r| r.ata),
-        n_modp: median(|r| r.n_modp),
-        motp: median(|r| r.motp),
-        mota: median(|r| r.mota),
-        idf1: median(|r| r.idf1),
-        hota: median(|r| r.hota),
-        id_switches: median(|r| r.id_switches),
-        tracks: median(|r| r.tracks),
-        tracking_ms_per_frame: median(|r| r.tracking_ms_per_frame),
+        sfda: of(|r| r.sfda),
+        ata: of(|r| r.ata),
+        n_modp: of(|r| r.n_modp),
+        motp: of(|r| r.motp),
+        mota: of(|r| r.mota),
+        idf1: of(|r| r.idf1),
+        hota: of(|r| r.hota),
+        id_switches: of(|r| r.id_switches),
+        tracks: of(|r| r.tracks),
+        tracking_ms_per_frame: of(|r| r.tracking_ms_per_frame),
     }
 }
 

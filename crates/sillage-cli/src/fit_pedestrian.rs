@@ -80,7 +80,7 @@ pub fn run_motion_prior(args: &FitMotionPriorArgs) -> Result<()> {
     let (tracks, ignored_rows) = group_tracks(path, &sequence.rows)?;
     let prior = MotionPrior::fit(&tracks, width, height, &params)
         .with_context(|| format!("cannot learn a motion prior from {}", path.display()))?;
-    prior.save(&args.out)?;
+    sillage::io::write_text(&args.out, &format!("{}\n", prior.to_json()))?;
     let (columns, rows) = prior.grid_size();
     let summary = MotionPriorSummary {
         tracks_file: path,
@@ -263,7 +263,8 @@ fn pedestrian_size(homography: &Homography, boxes: &[MotRow]) -> Option<Pedestri
     })
 }
 
-fn median(values: &mut [f64]) -> Option<f64> {
+/// The median of `values` (sorted in place); `None` when empty.
+pub(crate) fn median(values: &mut [f64]) -> Option<f64> {
     if values.is_empty() {
         return None;
     }
@@ -307,4 +308,15 @@ fn read_point_pairs(path: &Path) -> Result<Vec<PointPair>> {
         ));
     }
     Ok(pairs)
+}
+
+/// Reads a motion prior written by `sillage fit motion-prior`; errors name the file.
+pub fn read_motion_prior(path: &Path) -> Result<MotionPrior> {
+    let text = std::fs::read_to_string(path).with_context(|| {
+        format!(
+            "cannot read the motion prior {}; write it with `sillage fit motion-prior`",
+            path.display()
+        )
+    })?;
+    Ok(MotionPrior::from_json(path, &text)?)
 }

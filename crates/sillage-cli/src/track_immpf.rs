@@ -17,6 +17,7 @@ use sillage::track::immpf::{
 };
 
 use crate::cli::TrackImmpfArgs;
+use crate::fit_pedestrian::read_motion_prior;
 use crate::ground_plane::GroundPlaneFile;
 use crate::overlay::PedestrianOverlays;
 use crate::pedestrian_input::{PedestrianInput, PreparedFrame, seqinfo_beside};
@@ -54,7 +55,7 @@ pub fn load_scene(
         Some(path) => GroundPlaneFile::read_sizing(path)?,
         None => BoxSizing::FromCandidate,
     };
-    let prior = prior.map(MotionPrior::load).transpose()?;
+    let prior = prior.map(read_motion_prior).transpose()?;
     Ok((sizing, prior))
 }
 

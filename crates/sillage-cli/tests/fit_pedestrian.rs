@@ -6,7 +6,7 @@ use std::fs;
 use std::path::Path;
 
 mod common;
-use common::{path_str, sillage, stderr};
+use common::{path_str, run_ok, run_user_error};
 
 use serde::Deserialize;
 use sillage::core::{Homography, PedestrianSize, Point2};
@@ -44,19 +44,6 @@ struct FitTable {
 fn read_homography(path: &Path) -> HomographyFile {
     let text = fs::read_to_string(path).unwrap();
     toml::from_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"))
-}
-
-fn run_ok(args: &[&str]) -> String {
-    let output = sillage(args);
-    assert!(output.status.success(), "{}", stderr(&output));
-    String::from_utf8(output.stdout).unwrap()
-}
-
-/// Runs a command that must fail as a user error (exit 1) and returns its message.
-fn run_user_error(args: &[&str]) -> String {
-    let output = sillage(args);
-    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
-    stderr(&output)
 }
 
 #[test]
@@ -193,7 +180,7 @@ fn motion_prior_of_pets_is_written_and_loads() {
     let stdout = run_ok(&["fit", "motion-prior", &gt, "--out", path_str(&out)]);
     assert!(stdout.contains("4 rows with flag 0 ignored"), "{stdout}");
     assert!(stdout.contains("cells with data"), "{stdout}");
-    let prior = MotionPrior::load(&out).unwrap();
+    let prior = MotionPrior::from_json(&out, &fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(prior.image_size_px(), (768, 576));
     assert_eq!(prior.grid_size(), (26, 20));
     assert!(stdout.contains(&format!("{} cells with data", prior.cells_with_data())));
@@ -213,7 +200,7 @@ fn motion_prior_of_pets_is_written_and_loads() {
         "--out",
         path_str(&out),
     ]);
-    let prior = MotionPrior::load(&out).unwrap();
+    let prior = MotionPrior::from_json(&out, &fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(prior.grid_size(), (20, 15));
 }
 

@@ -8,24 +8,12 @@ use std::path::Path;
 use std::process::Command;
 
 mod common;
-use common::{path_str, sillage, stderr};
+use common::{path_str, run_ok, run_user_error, stderr};
 
 const PETS: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../../../shared/data/pets09_s2l1"
 );
-
-fn run_ok(args: &[&str]) -> String {
-    let output = sillage(args);
-    assert!(output.status.success(), "{}", stderr(&output));
-    String::from_utf8(output.stdout).unwrap()
-}
-
-fn run_user_error(args: &[&str]) -> String {
-    let output = sillage(args);
-    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
-    stderr(&output)
-}
 
 /// The ground plane of PETS fitted from its truth (`sillage fit homography`).
 fn ground_plane(dir: &Path) -> String {

@@ -20,3 +20,19 @@ pub fn stderr(output: &Output) -> String {
 pub fn path_str(path: &Path) -> &str {
     path.to_str().expect("utf-8 path")
 }
+
+/// Runs a command that must succeed and returns its standard output.
+#[allow(dead_code)] // not every test file runs commands through it
+pub fn run_ok(args: &[&str]) -> String {
+    let output = sillage(args);
+    assert!(output.status.success(), "{}", stderr(&output));
+    String::from_utf8(output.stdout).expect("utf-8 output")
+}
+
+/// Runs a command that must fail as a user error (exit 1) and returns its message.
+#[allow(dead_code)] // not every test file runs commands through it
+pub fn run_user_error(args: &[&str]) -> String {
+    let output = sillage(args);
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    stderr(&output)
+}

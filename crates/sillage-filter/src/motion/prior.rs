@@ -25,8 +25,7 @@
 //! assert!(v.x.is_finite() && v.y.is_finite());
 //! ```
 
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 use sillage_core::{Error, FrameIndex, Point2, Result, Vec2};
@@ -34,7 +33,8 @@ use sillage_core::{Error, FrameIndex, Point2, Result, Vec2};
 use crate::noise::Gauss2;
 use crate::normal::Normals;
 
-/// The version of the JSON layout [`MotionPrior::save`] writes and [`MotionPrior::load`] reads.
+/// The version of the JSON layout [`MotionPrior::to_json`] writes and [`MotionPrior::from_json`]
+/// reads.
 pub const MOTION_PRIOR_FORMAT_VERSION: u32 = 1;
 
 /// Bins per cell: stay and the 8 compass directions.
@@ -485,69 +485,11 @@ impl MotionPrior {
             file.cells,
         ))
     }
-
-    /// Writes the prior as JSON at `path`, through `.NAME.partial` in the same folder renamed
-    /// at the end, so a reader never sees half a file.
-    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
-        let path = path.as_ref();
-        let partial = partial_path(path)?;
-        let hint = "check that the folder exists and is writable";
-        let written = std::fs::File::create(&partial).and_then(|mut file| {
-            file.write_all(self.to_json().as_bytes())?;
-            file.write_all(b"\n")?;
-            file.flush()
-        });
-        if let Err(cause) = written {
-            let _ = std::fs::remove_file(&partial);
-            return Err(Error::Io {
-                path: partial,
-                cause,
-                hint: hint.into(),
-            });
-        }
-        std::fs::rename(&partial, path).map_err(|cause| {
-            let _ = std::fs::remove_file(&partial);
-            Error::Io {
-                path: path.to_path_buf(),
-                cause,
-                hint: hint.into(),
-            }
-        })
-    }
-
-    /// Reads a prior written by [`MotionPrior::save`]; errors name the file.
-    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
-        let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-        let text = std::str::from_utf8(&bytes).map_err(|_| {
-            Error::format(
-                path,
-                None,
-                "not UTF-8 text, so not a motion prior file; write it again with `sillage fit \
-                 motion-prior`",
-            )
-        })?;
-        Self::from_json(path, text)
-    }
 }
 
 /// Compact JSON of a part of the prior file (plain structs of numbers always serialise).
 fn compact<T: Serialize>(value: &T) -> String {
     serde_json::to_string(value).unwrap_or_default()
-}
-
-/// `.NAME.partial` beside `path`.
-fn partial_path(path: &Path) -> Result<PathBuf> {
-    let name = path.file_name().ok_or_else(|| {
-        Error::input(format!(
-            "{}: the output must name a file, not a folder",
-            path.display()
-        ))
-    })?;
-    let mut partial = std::ffi::OsString::from(".");
-    partial.push(name);
-    partial.push(".partial");
-    Ok(path.with_file_name(partial))
 }
 
 /// The cell of `pos_px` in a `columns` × `rows` grid of `cell_px` cells whose top-left corner
@@ -737,15 +679,11 @@ mod tests {
     }
 
     #[test]
-    fn save_and_load_round_trip_and_bad_files_name_the_file() {
-        let dir = std::env::temp_dir().join(format!("sillage-prior-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("prior.json");
+    fn json_round_trips_and_bad_text_names_the_file() {
+        let path = Path::new("prior.json");
         let prior = MotionPrior::fit(&walkers(), 300, 300, &MotionPriorParams::default()).unwrap();
-        prior.save(&path).unwrap();
-        assert_eq!(MotionPrior::load(&path).unwrap(), prior);
-        assert!(!dir.join(".prior.json.partial").exists());
-        let text = std::fs::read_to_string(&path).unwrap();
+        let text = prior.to_json();
+        assert_eq!(MotionPrior::from_json(path, &text).unwrap(), prior);
         assert!(text.contains("\"format_version\": 1"), "{}", &text[..80]);
         let cases = [
             (
@@ -759,15 +697,10 @@ mod tests {
             ("{\"oops\": 1}".to_string(), "not a motion prior file"),
         ];
         for (bad, expected) in cases {
-            let bad_path = dir.join("bad.json");
-            std::fs::write(&bad_path, bad).unwrap();
-            let err = MotionPrior::load(&bad_path).unwrap_err().to_string();
+            let err = MotionPrior::from_json(Path::new("bad.json"), &bad)
+                .unwrap_err()
+                .to_string();
             assert!(err.contains("bad.json") && err.contains(expected), "{err}");
         }
-        let err = MotionPrior::load(dir.join("missing.json"))
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("missing.json"), "{err}");
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
