@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
-use sillage::core::{FrameIndex, RgbImage};
+use sillage::core::{FrameIndex, GrayImage, RgbImage};
 use sillage::detect::motion::{MotionBlob, MotionDetector, MotionParams};
 use sillage::io::read_mot_rows;
 use sillage::io::{FrameOptions, FrameSource, open_frames};
@@ -30,7 +30,10 @@ pub struct PedestrianInput {
     detections: Option<BTreeMap<FrameIndex, Vec<Candidate>>>,
     motion: Option<MotionDetector>,
     appearance: AppearanceParams,
+    /// Spare buffers for the next frame's bins (see [`PedestrianInput::recycle`]).
     cues: FrameCues,
+    /// The previous frame's grey levels, for the motion histogram.
+    previous: Option<GrayImage>,
     keep_colour: bool,
     /// Frames in the detections-only mode: 0 to the last detection frame (or `frame_count`).
     next_frame: FrameIndex,
@@ -129,6 +132,7 @@ impl PedestrianInput {
             motion,
             appearance: appearance.clone(),
             cues: FrameCues::default(),
+            previous: None,
             keep_colour,
             next_frame: 0,
             end_frame: end,
@@ -172,23 +176,40 @@ impl PedestrianInput {
             }
             None => None,
         };
-        self.cues
-            .update(&self.appearance, colour, &frame.image, foreground)
-            .with_context(context)?;
+        // The buffers the consumer gave back (`recycle`), or new ones.
+        let mut cues = std::mem::take(&mut self.cues);
+        cues.update(
+            &self.appearance,
+            colour,
+            &frame.image,
+            self.previous.as_ref(),
+            foreground,
+        )
+        .with_context(context)?;
         let candidates = match &self.detections {
             Some(_) => self.candidates_of(frame.index),
             None => blobs.iter().map(blob_candidate).collect(),
         };
-        Ok(Some(PreparedFrame {
+        let prepared = PreparedFrame {
             frame: frame.index,
-            cues: Some(self.cues.without_history()),
+            cues: Some(cues),
             candidates,
             colour: if self.keep_colour {
                 frame.colour.take()
             } else {
                 None
             },
-        }))
+        };
+        self.previous = Some(frame.image);
+        Ok(Some(prepared))
+    }
+
+    /// Gives a frame's buffers back once it is tracked, so that streaming allocates nothing
+    /// per frame (a cache of prepared frames simply keeps them).
+    pub fn recycle(&mut self, frame: PreparedFrame) {
+        if let Some(cues) = frame.cues {
+            self.cues = cues;
+        }
     }
 
     fn candidates_of(&self, frame: FrameIndex) -> Vec<Candidate> {

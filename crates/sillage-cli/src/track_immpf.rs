@@ -125,6 +125,7 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         if let Some(o) = &mut overlays {
             o.push(&prepared, &estimates)?;
         }
+        input.recycle(prepared);
         rows += estimates.len() as u64;
         last_id = estimates.iter().map(|e| e.track_id).fold(last_id, u64::max);
         frames += 1;

@@ -81,6 +81,7 @@ fn run(
     let mut tracker =
         PedestrianTracker::new(params, BoxSizing::FromCandidate, None, (W, H), seed).unwrap();
     let mut cues = FrameCues::default();
+    let mut previous: Option<GrayImage> = None;
     let mut out = Vec::new();
     for frame in 0..frames {
         let candidates: Vec<Candidate> = (0..WALKERS.len())
@@ -91,8 +92,15 @@ fn run(
             .collect();
         let cues = if images {
             let (rgb, grey, mask) = render(frame);
-            cues.update(&params.appearance, &rgb, &grey, Some(&mask))
-                .unwrap();
+            cues.update(
+                &params.appearance,
+                &rgb,
+                &grey,
+                previous.as_ref(),
+                Some(&mask),
+            )
+            .unwrap();
+            previous = Some(grey);
             Some(&cues)
         } else {
             None

@@ -97,26 +97,26 @@ impl AppearanceParams {
 }
 
 /// The per-pixel bins of one frame: colour, motion from the previous frame's grey levels,
-/// and the foreground mask's summed areas.
+/// and the foreground mask's summed areas. Its buffers are reused when it is updated again.
 #[derive(Debug, Clone, Default)]
 pub struct FrameCues {
     colour: BinImage,
     motion: BinImage,
     foreground: ForegroundShare,
-    previous: Option<GrayImage>,
     has_motion: bool,
     has_foreground: bool,
 }
 
 impl FrameCues {
-    /// Bins `colour` and the difference of `grey` with the previous frame's (none at the
-    /// first frame: the motion term is then left out), and sums the `foreground` mask (none:
-    /// the foreground term is left out). Frames must keep one size.
+    /// Bins `colour` and the difference of `grey` with `previous`, the previous frame's grey
+    /// levels (none at the first frame: the motion term is then left out), and sums the
+    /// `foreground` mask (none: the foreground term is left out). Frames must keep one size.
     pub fn update(
         &mut self,
         params: &AppearanceParams,
         colour: &RgbImage,
         grey: &GrayImage,
+        previous: Option<&GrayImage>,
         foreground: Option<&Image<bool>>,
     ) -> Result<()> {
         self.colour.fill_hsv(colour, &params.binning)?;
@@ -124,38 +124,16 @@ impl FrameCues {
         if let Some(mask) = foreground {
             self.foreground.fill(mask);
         }
-        self.has_motion = false;
-        if let Some(previous) = &self.previous {
+        self.has_motion = previous.is_some();
+        if let Some(previous) = previous {
             self.motion.fill_difference(
                 previous,
                 grey,
                 params.motion_bins,
                 params.motion_full_scale,
             )?;
-            self.has_motion = true;
-        }
-        match &mut self.previous {
-            Some(previous) if previous.dimensions() == grey.dimensions() => {
-                previous.as_mut_slice().copy_from_slice(grey.as_slice());
-            }
-            slot => *slot = Some(grey.clone()),
         }
         Ok(())
-    }
-}
-
-impl FrameCues {
-    /// A copy of this frame's bins without the previous frame's grey levels (what a cache
-    /// of prepared frames keeps: the next update needs the history, a tracker does not).
-    pub fn without_history(&self) -> Self {
-        Self {
-            colour: self.colour.clone(),
-            motion: self.motion.clone(),
-            foreground: self.foreground.clone(),
-            previous: None,
-            has_motion: self.has_motion,
-            has_foreground: self.has_foreground,
-        }
     }
 }
 
