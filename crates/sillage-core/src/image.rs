@@ -17,6 +17,17 @@ pub type GrayImage = Image<f32>;
 /// An 8-bit colour picture (red, green, blue), as charts and overlays are drawn.
 pub type RgbImage = Image<[u8; 3]>;
 
+/// Rec. 601 luma weights for R, G, B: the weights OpenCV's `BGR2GRAY` uses, the one colour to
+/// grey conversion of the workspace (frame decoding, synthetic colour frames).
+pub const LUMA_601: [f32; 3] = [0.299, 0.587, 0.114];
+
+/// The Rec. 601 luma of an 8-bit colour pixel, in `[0, 1]`: bit for bit what decoding the
+/// pixel from a colour PNG gives (each sample / 255, then the weighted sum).
+pub fn luma_601(rgb: [u8; 3]) -> f32 {
+    let unit = |v: u8| f32::from(v) / 255.0;
+    LUMA_601[0] * unit(rgb[0]) + LUMA_601[1] * unit(rgb[1]) + LUMA_601[2] * unit(rgb[2])
+}
+
 impl<T: Copy + Default> Image<T> {
     /// A `width × height` image filled with `T::default()`.
     pub fn new(width: usize, height: usize) -> Self {

@@ -33,7 +33,7 @@ pub use calibration::Calibration;
 pub use error::{Error, Result};
 pub use geometry::{Point2, Vec2};
 pub use homography::{Homography, PedestrianSize};
-pub use image::{GrayImage, Image, RgbImage};
+pub use image::{GrayImage, Image, LUMA_601, RgbImage, luma_601};
 pub use observation::{
     BLACK_BEAD_CLASS, Detection, FrameIndex, MotionState, ObjectClass, TRANSPARENT_BEAD_CLASS,
     TrackId, TrackPoint, TruthPoint,

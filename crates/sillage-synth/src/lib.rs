@@ -1,5 +1,5 @@
-//! Seeded synthetic scenes with ground truth: the TracTrac vortex flow and its renderer, and
-//! the MMPF+ bedload sequence.
+//! Seeded synthetic scenes with ground truth: the TracTrac vortex flow and its renderer, the
+//! MMPF+ bedload sequence, and walkers with occlusions for the pedestrian trackers.
 //!
 //! - [`vortex`]: the unsteady, non-uniform vortex flow of the TracTrac paper (§4.1.1,
 //!   Eqs. 13-16), as positions only ([`VortexFlow`], [`VortexTruth`]) or as rendered frames
@@ -9,6 +9,11 @@
 //!   misses, false positives and the detector-confidence candidates of Eq. (1)
 //!   ([`BedloadScene`], [`BeadDetectionModel`], [`BedloadSequence`]), and its frames rendered
 //!   as backlit grey images like the paper's ([`BedloadRenderer`]).
+//! - [`walkers`]: people walking over a static background, in depth order with full and
+//!   partial occlusions, as colour and grey frames with MOTChallenge-style truth (box,
+//!   visibility, depth): a crossing with a full occlusion, a group that splits, a random
+//!   crowd ([`WalkersParams`], [`Scenario`], [`WalkersSequence`]); the acceptance sequences
+//!   of the SIFT-PF tracker (Souded et al. 2011).
 //! - [`render_spots`]: Gaussian spots plus uniform or Gaussian noise, for any test or bench
 //!   that needs an image with known centres.
 //!
@@ -31,6 +36,7 @@ pub mod bedload;
 mod noise;
 mod render;
 pub mod vortex;
+pub mod walkers;
 
 pub use bedload::{
     BeadDetectionModel, BedloadDetectionParams, BedloadFrame, BedloadObservation,
@@ -43,4 +49,8 @@ pub use render::render_spots;
 pub use vortex::{
     DisplacementStats, SyntheticFrame, TruthFrame, VortexFlow, VortexParams, VortexSequence,
     VortexTruth, displacement_stats, p_inverse, vortex_map,
+};
+pub use walkers::{
+    CrossingParams, GroupSplitParams, RandomParams, Scenario, WalkerTruth, WalkersFrame,
+    WalkersParams, WalkersSequence,
 };

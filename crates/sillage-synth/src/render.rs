@@ -10,7 +10,7 @@ use crate::noise::{Noise, NoiseKind};
 
 /// Rows per band: the unit of parallel work and of noise streams (fixed, so that the image
 /// does not depend on the number of threads).
-const BAND_ROWS: usize = 16;
+pub(crate) const BAND_ROWS: usize = 16;
 
 /// A spot is drawn in a window of ± this many standard deviations (the rest is < 3.4e-4 of
 /// its peak).
@@ -95,7 +95,7 @@ fn spots_per_band(height: usize, windows: &[Option<Window>]) -> Vec<Vec<usize>> 
 }
 
 /// Fills one band with noise drawn from its own stream `(seed, band)`.
-fn fill_noise(pixels: &mut [f32], noise: Noise, seed: u64, band: u64) {
+pub(crate) fn fill_noise(pixels: &mut [f32], noise: Noise, seed: u64, band: u64) {
     if noise.magnitude == 0.0 {
         pixels.fill(0.0);
         return;

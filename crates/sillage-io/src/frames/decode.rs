@@ -13,14 +13,11 @@
 
 use std::path::Path;
 
-use sillage_core::{GrayImage, Result, RgbImage};
+use sillage_core::{GrayImage, LUMA_601, Result, RgbImage};
 use tiff::ColorType;
 use tiff::decoder::{Decoder, DecodingResult};
 
 use super::ccitt;
-
-/// Rec. 601 luma weights for R, G, B.
-const LUMA_601: [f32; 3] = [0.299, 0.587, 0.114];
 
 /// Why a frame could not be decoded; the caller adds the file and the frame index.
 pub(crate) type DecodeResult<T> = std::result::Result<T, String>;
