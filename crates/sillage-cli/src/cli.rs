@@ -23,6 +23,7 @@ const EXAMPLES: &str = "Examples:
   sillage ptv frames/ --tractrac-par tifseq_par.txt --out tracks.csv
   sillage synth vortex --out vortex/ --frames 50 --particles 2000 --snr 6
   sillage synth bedload --out beads/ --frames 200
+  sillage synth walkers --scenario crossing --out walkers/ && sillage track immpf walkers/img1 ...
   sillage eval ptv --truth vortex/truth.csv --tracks tracks.csv
   sillage eval mot --gt MOT17/train --pred tracker/data --protocol mot17
   sillage eval mot --gt vortex/truth.csv --pred tracks.csv --match dist:1 --json
@@ -118,6 +119,46 @@ pub enum SynthCommand {
     /// Bedload beads (MMPF+ paper): truth with motion states, detections with misses, bursts
     /// and false positives, and confidence candidates, as CSV.
     Bedload(SynthBedloadArgs),
+    /// People walking with occlusions (the SIFT-PF acceptance cases): a MOTChallenge sequence
+    /// folder, img1/*.png, gt/gt.txt and seqinfo.ini.
+    Walkers(SynthWalkersArgs),
+}
+
+/// The walkers scenarios of the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum WalkersScenarioArg {
+    /// Two walkers crossing; the near one hides the far one for 5 frames.
+    Crossing,
+    /// Two walkers entering together (one blob) who then split.
+    GroupSplit,
+    /// Walkers entering from the borders at random times and speeds.
+    Random,
+}
+
+/// `sillage synth walkers`.
+#[derive(Debug, Args)]
+pub struct SynthWalkersArgs {
+    /// Output sequence folder (created): img1/000001.png ..., gt/gt.txt, seqinfo.ini.
+    #[arg(long, short, value_name = "DIR")]
+    pub out: PathBuf,
+    /// What the walkers do.
+    #[arg(long, value_enum, default_value_t = WalkersScenarioArg::Crossing)]
+    pub scenario: WalkersScenarioArg,
+    /// Number of walkers (random scenario only; the others have two).
+    #[arg(long)]
+    pub walkers: Option<usize>,
+    /// Number of frames, the 10 empty warm-up frames included (default 150).
+    #[arg(long)]
+    pub frames: Option<usize>,
+    /// Frame width, px.
+    #[arg(long, default_value_t = 320)]
+    pub width: usize,
+    /// Frame height, px.
+    #[arg(long, default_value_t = 240)]
+    pub height: usize,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 /// `sillage synth bedload`.

@@ -24,6 +24,7 @@ mod progress;
 mod ptv;
 mod synth;
 mod synth_bedload;
+mod synth_walkers;
 mod track;
 mod track_immpf;
 
@@ -35,6 +36,7 @@ fn main() {
         cli::Command::Ptv(a) => ptv::run(&a),
         cli::Command::Synth(cli::SynthCommand::Vortex(a)) => synth::run_vortex(&a),
         cli::Command::Synth(cli::SynthCommand::Bedload(a)) => synth_bedload::run_bedload(&a),
+        cli::Command::Synth(cli::SynthCommand::Walkers(a)) => synth_walkers::run(&a),
         cli::Command::Eval(cli::EvalCommand::Ptv(a)) => eval::run_ptv(&a),
         cli::Command::Eval(cli::EvalCommand::Mot(a)) => eval_mot::run(&a),
         cli::Command::Demo(a) => match &a.kind {

@@ -373,27 +373,8 @@ impl MotResultsWriter {
     /// Appends `rows` (whole rows, one write).
     pub fn push(&mut self, rows: &[MotRow]) -> Result<()> {
         self.rows.write_rows(rows, |out, row| {
-            let frame = row.frame.checked_add(1).ok_or_else(|| {
-                Error::input(format!("frame {} cannot be written 1-based", row.frame))
-            })?;
-            // Writing to a String cannot fail.
-            let _ = write!(out, "{frame},");
-            match row.id {
-                Some(id) => {
-                    let _ = write!(out, "{id}");
-                }
-                None => out.push_str("-1"),
-            }
             let world = row.world.unwrap_or([-1.0; 3]);
-            let values = [row.left_px, row.top_px, row.width_px, row.height_px]
-                .into_iter()
-                .chain([row.confidence.unwrap_or(-1.0)])
-                .chain(world);
-            for v in values {
-                out.push(',');
-                push_f64(out, v);
-            }
-            Ok(())
+            push_mot_row(out, row, world)
         })
     }
 
@@ -401,6 +382,83 @@ impl MotResultsWriter {
     pub fn finish(self) -> Result<WrittenSummary> {
         self.rows.finish()
     }
+}
+
+/// Writes MOTChallenge ground truth as MOT16/17/20 have it (9 fields:
+/// `frame,id,bb_left,bb_top,bb_width,bb_height,consider,class,visibility`, frames 1-based,
+/// `-1` for what is absent) batch by batch into `.NAME.partial`, renamed on
+/// [`MotGroundTruthWriter::finish`]; the consider flag is [`MotRow::confidence`].
+#[derive(Debug)]
+pub struct MotGroundTruthWriter {
+    rows: RowWriter,
+}
+
+impl MotGroundTruthWriter {
+    /// Creates the writer (no header: MOTChallenge files have none).
+    pub fn create(path: impl AsRef<Path>) -> Result<Self> {
+        Ok(Self {
+            rows: RowWriter::create(path.as_ref(), "")?,
+        })
+    }
+
+    /// Appends `rows` (whole rows, one write).
+    pub fn push(&mut self, rows: &[MotRow]) -> Result<()> {
+        self.rows.write_rows(rows, |out, row| {
+            let class = row.class.map_or(-1.0, |c| c as f64);
+            push_mot_row(out, row, [class, row.visibility.unwrap_or(-1.0)])
+        })
+    }
+
+    /// Closes the file under its final name.
+    pub fn finish(self) -> Result<WrittenSummary> {
+        self.rows.finish()
+    }
+}
+
+/// One MOTChallenge row into `out`: the 1-based frame, the id (`-1` without), the box, the
+/// 7th column (`-1` without) and the layout's `tail` columns.
+fn push_mot_row<const N: usize>(out: &mut String, row: &MotRow, tail: [f64; N]) -> Result<()> {
+    let frame = row
+        .frame
+        .checked_add(1)
+        .ok_or_else(|| Error::input(format!("frame {} cannot be written 1-based", row.frame)))?;
+    // Writing to a String cannot fail.
+    let _ = write!(out, "{frame},");
+    match row.id {
+        Some(id) => {
+            let _ = write!(out, "{id}");
+        }
+        None => out.push_str("-1"),
+    }
+    let values = [row.left_px, row.top_px, row.width_px, row.height_px]
+        .into_iter()
+        .chain([row.confidence.unwrap_or(-1.0)])
+        .chain(tail);
+    for v in values {
+        out.push(',');
+        push_f64(out, v);
+    }
+    Ok(())
+}
+
+/// Writes `info` as a `seqinfo.ini` at `path` (a `[Sequence]` section with the keys that are
+/// set, in MOTChallenge's spelling), under a temporary name renamed when complete.
+pub fn write_seqinfo(path: impl AsRef<Path>, info: &SeqInfo) -> Result<()> {
+    let mut text = String::from("[Sequence]\n");
+    let mut line = |key: &str, value: Option<String>| {
+        if let Some(value) = value {
+            // Writing to a String cannot fail.
+            let _ = writeln!(text, "{key}={value}");
+        }
+    };
+    line("name", info.name.clone());
+    line("imDir", info.image_dir.clone());
+    line("frameRate", info.frame_rate.map(|r| r.to_string()));
+    line("seqLength", info.frame_count.map(|n| n.to_string()));
+    line("imWidth", info.image_width.map(|w| w.to_string()));
+    line("imHeight", info.image_height.map(|h| h.to_string()));
+    line("imExt", info.image_ext.clone());
+    crate::write_text(path, &text)
 }
 
 /// Writes `rows` as a MOTChallenge results file at `path` in one go.
@@ -413,6 +471,44 @@ pub fn write_mot_results(path: impl AsRef<Path>, rows: &[MotRow]) -> Result<()> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ground_truth_and_seqinfo_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let row = MotRow {
+            frame: 4,
+            id: Some(7),
+            left_px: -3.25,
+            top_px: 10.5,
+            width_px: 24.0,
+            height_px: 64.0,
+            confidence: Some(1.0),
+            class: Some(1),
+            visibility: Some(0.375),
+            world: None,
+        };
+        let gt = dir.path().join("gt.txt");
+        let mut writer = MotGroundTruthWriter::create(&gt).unwrap();
+        writer.push(&[row]).unwrap();
+        writer.finish().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&gt).unwrap(),
+            "5,7,-3.25,10.5,24,64,1,1,0.375\n"
+        );
+        assert_eq!(read_mot_rows(&gt).unwrap(), vec![row]);
+        let info = SeqInfo {
+            name: Some("walkers".into()),
+            frame_count: Some(150),
+            frame_rate: Some(25.0),
+            image_width: Some(320),
+            image_height: Some(240),
+            image_dir: Some("img1".into()),
+            image_ext: Some(".png".into()),
+        };
+        let ini = dir.path().join("seqinfo.ini");
+        write_seqinfo(&ini, &info).unwrap();
+        assert_eq!(read_seqinfo(&ini).unwrap(), info);
+    }
 
     fn parse(text: &str) -> Result<Vec<MotRow>> {
         parse_mot_rows(Path::new("gt.txt"), text.as_bytes())
