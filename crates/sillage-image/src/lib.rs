@@ -14,7 +14,9 @@
 //! - [`mask`]: masks and rectangular regions of interest ([`Roi`]);
 //! - [`histogram`]: HSV colour and frame-difference histograms of boxes ([`BinImage`],
 //!   [`HsvBinning`]) compared by the Bhattacharyya coefficient, the observation model of the
-//!   pedestrian IMM particle filter (Pérez, Vermaak & Blake 2004).
+//!   pedestrian IMM particle filter (Pérez, Vermaak & Blake 2004);
+//! - [`sift`]: SIFT keypoints and descriptors (Lowe 2004, as OpenCV), with descriptors at any
+//!   position, scale and orientation for the SIFT-PF tracker ([`SiftDetector`]).
 //!
 //! Filters own their scratch buffers, so processing frame after frame allocates nothing once
 //! the first frame has sized them, and every result is bit-identical whatever the number of
@@ -58,6 +60,7 @@ pub mod morphology;
 pub mod ncc;
 pub mod reconstruct;
 mod separable;
+pub mod sift;
 pub mod stats;
 pub mod structuring;
 pub mod subpixel;
@@ -77,6 +80,7 @@ pub use median::{MedianSize, median_filter};
 pub use morphology::Morphology;
 pub use ncc::{MAX_TEMPLATE_RADIUS_PX, RingCorrelator, RingTemplate};
 pub use reconstruct::Reconstruction;
+pub use sift::{SiftDescriptor, SiftDetector, SiftKeypoint, SiftParams};
 pub use stats::{MeanStd, MedianMad, mean_std, median_mad};
 pub use structuring::{MAX_ELEMENT_RADIUS_PX, StructuringElement};
 pub use subpixel::{SubpixelFit, parabola_offset, refine_peak};
