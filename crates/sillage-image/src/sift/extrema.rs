@@ -11,7 +11,13 @@
 //! threshold` (Eq. (3)'s contrast, OpenCV's scaling by `s`) whose 2×2 spatial Hessian has
 //! `det > 0` and `tr²/det < (r+1)²/r` (§4.1).
 
+use std::ops::Range;
+
 use super::pyramid::{BORDER, Octave};
+use super::simd::multiversion;
+
+/// Columns tested at once by [`RowCandidates`].
+const STRIP: usize = 64;
 
 /// Fits per extremum before giving up (OpenCV's `SIFT_MAX_INTERP_STEPS`).
 pub(crate) const MAX_REFINE_STEPS: usize = 5;
@@ -58,39 +64,29 @@ impl ExtremumTest {
         }
     }
 
-    /// Whether DoG sample `(col, row)` of `layer` is a candidate: above the pre-filter and an
-    /// extremum of its 26 neighbours (ties allowed, as OpenCV).
-    pub fn is_candidate(&self, octave: &Octave, layer: usize, col: usize, row: usize) -> bool {
-        let dog = &octave.dog;
-        let width = dog[layer].width();
-        let value = dog[layer].as_slice()[row * width + col];
-        if value.abs() <= self.prefilter {
-            return false;
-        }
-        let neighbours = |image: &sillage_core::GrayImage| {
-            let data = image.as_slice();
-            let centre = row * width + col;
-            [
-                centre - width - 1,
-                centre - width,
-                centre - width + 1,
-                centre - 1,
-                centre,
-                centre + 1,
-                centre + width - 1,
-                centre + width,
-                centre + width + 1,
-            ]
-            .map(|i| data[i])
-        };
-        let mut window = [0f32; 27];
-        for (k, image) in dog[layer - 1..=layer + 1].iter().enumerate() {
-            window[9 * k..9 * k + 9].copy_from_slice(&neighbours(image));
-        }
-        if value > 0.0 {
-            window.iter().all(|&v| value >= v)
-        } else {
-            window.iter().all(|&v| value <= v)
+    /// The candidate columns of DoG row `row` of `layer` within `cols` (which must keep one
+    /// sample away from the sides), in order.
+    pub fn candidates<'a>(
+        &self,
+        octave: &'a Octave,
+        layer: usize,
+        row: usize,
+        cols: Range<usize>,
+    ) -> RowCandidates<'a> {
+        let rows = std::array::from_fn(|k| {
+            let (l, r) = (layer + k / 3 - 1, row + k % 3 - 1);
+            let image = &octave.dog[l];
+            &image.row(r)[cols.start - 1..cols.end + 1]
+        });
+        RowCandidates {
+            rows,
+            threshold: self.prefilter,
+            first_col: cols.start,
+            strip_start: 0,
+            strip_end: 0,
+            flags: [0; STRIP],
+            strip_len: 0,
+            next: 0,
         }
     }
 
@@ -151,6 +147,108 @@ impl ExtremumTest {
             contrast,
             edge_ratio: trace * trace / det,
         })
+    }
+}
+
+/// The candidates of one DoG row, found [`STRIP`] columns at a time by a branch-free pass
+/// (vectorised) that compares each sample with the maximum and minimum of its 3×3×3
+/// neighbourhood (itself included, so that ties count, as OpenCV's `≥`).
+pub(crate) struct RowCandidates<'a> {
+    /// The 9 rows of the neighbourhood (layer-major: layer − 1, layer, layer + 1; rows
+    /// above, at, below), each from one column before the range to one after.
+    rows: [&'a [f32]; 9],
+    threshold: f32,
+    first_col: usize,
+    strip_start: usize,
+    /// End of the last strip filled (relative to the range).
+    strip_end: usize,
+    flags: [u8; STRIP],
+    strip_len: usize,
+    next: usize,
+}
+
+impl RowCandidates<'_> {
+    /// Flags the columns of the strip starting at `start` (relative to the range).
+    fn fill(&mut self, start: usize) {
+        fill_widest(self, start);
+    }
+}
+
+multiversion! {
+    /// [`fill_strip`] on the widest SIMD the CPU offers (the same flags on every path: only
+    /// exact comparisons).
+    fn fill_widest(candidates: &mut RowCandidates<'_>, start: usize) => fill_strip
+}
+
+/// The flags of one strip: none when no sample passes the pre-filter (most strips of the
+/// doubled octave, whose DoG is small), else the 3×3×3 maximum and minimum from running maxima
+/// and minima of three adjacent samples in each of the 9 rows, in loops the compiler
+/// vectorises.
+#[inline(always)]
+fn fill_strip(candidates: &mut RowCandidates<'_>, start: usize) {
+    let rows = candidates.rows;
+    let len = (rows[4].len() - 2 - start).min(STRIP);
+    candidates.strip_start = start;
+    candidates.next = 0;
+    let centre = &rows[4][start + 1..start + len + 1];
+    let threshold = candidates.threshold;
+    let above = centre
+        .iter()
+        .fold(false, |any, &value| any | (value.abs() > threshold));
+    if !above {
+        candidates.strip_len = 0;
+        return;
+    }
+    let mut high = [f32::NEG_INFINITY; STRIP];
+    let mut low = [f32::INFINITY; STRIP];
+    for row in rows {
+        let row = &row[start..start + len + 2];
+        let triples = row.iter().zip(&row[1..]).zip(&row[2..]);
+        for ((h, l), ((&a, &b), &c)) in high.iter_mut().zip(&mut low).zip(triples) {
+            *h = max(*h, max(a, max(b, c)));
+            *l = min(*l, min(a, min(b, c)));
+        }
+    }
+    for (((flag, &value), &h), &l) in candidates.flags.iter_mut().zip(centre).zip(&high).zip(&low) {
+        let maximum = value > threshold && value >= h;
+        let minimum = value < -threshold && value <= l;
+        *flag = u8::from(maximum | minimum);
+    }
+    candidates.strip_len = len;
+}
+
+/// `a.max(b)` without NaN handling (one `maxps`).
+#[inline]
+fn max(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+/// `a.min(b)` without NaN handling (one `minps`).
+#[inline]
+fn min(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+impl Iterator for RowCandidates<'_> {
+    type Item = usize;
+
+    fn next(&mut self) -> Option<usize> {
+        let width = self.rows[4].len() - 2;
+        loop {
+            while self.next < self.strip_len {
+                let k = self.next;
+                self.next += 1;
+                if self.flags[k] != 0 {
+                    return Some(self.first_col + self.strip_start + k);
+                }
+            }
+            let start = self.strip_end;
+            if start >= width {
+                return None;
+            }
+            self.strip_end = (start + STRIP).min(width);
+            self.fill(start);
+        }
     }
 }
 

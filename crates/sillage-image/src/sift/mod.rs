@@ -47,6 +47,7 @@ mod extrema;
 mod orientation;
 pub mod params;
 mod pyramid;
+mod simd;
 
 use rayon::prelude::*;
 use sillage_core::{GrayImage, Result};
@@ -141,8 +142,8 @@ impl SiftDetector {
             };
             for layer in 1..=self.space.layers() {
                 out.par_extend(rows.clone().into_par_iter().flat_map_iter(|row| {
-                    cols.clone()
-                        .filter(move |&col| self.test.is_candidate(octave, layer, col, row))
+                    self.test
+                        .candidates(octave, layer, row, cols.clone())
                         .filter_map(move |col| self.test.refine(octave, layer, col, row))
                         .flat_map(move |extremum| self.oriented(o, octave, extremum))
                         .filter(move |kp| region.is_none_or(|b| contains(&b, kp.x, kp.y)))

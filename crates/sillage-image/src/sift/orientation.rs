@@ -59,8 +59,8 @@ pub(crate) fn orientation_histogram(
         for x in cols.clone() {
             let i = start + x as usize;
             let weight = row_weight * weights[(x - col + radius) as usize];
-            let bin =
-                (direction.as_slice()[i] * bins_per_radian).round() as usize % ORIENTATION_BINS;
+            // Directions are ≥ 0: adding ½ and truncating rounds (no libm call).
+            let bin = (direction.as_slice()[i] * bins_per_radian + 0.5) as usize % ORIENTATION_BINS;
             raw[bin] += weight * magnitude.as_slice()[i];
         }
     }

@@ -18,6 +18,7 @@ use rayon::prelude::*;
 use sillage_core::{Error, GrayImage, Result};
 
 use super::params::SiftParams;
+use super::simd::multiversion;
 use crate::gaussian::GaussianFilter;
 
 /// Pixels left out at each side of an octave when searching extrema (OpenCV's `SIFT_IMG_BORDER`).
@@ -262,30 +263,47 @@ fn gradients(level: &GrayImage, magnitude: &mut GrayImage, orientation: &mut Gra
         .enumerate()
         .with_min_len(ROWS_PER_JOB)
         .for_each(|(y, (mag, ori))| {
-            mag.fill(0.0);
-            ori.fill(0.0);
             if y == 0 || y + 1 >= height || width < 3 {
+                mag.fill(0.0);
+                ori.fill(0.0);
                 return;
             }
-            let (up, row, down) = (level.row(y - 1), level.row(y), level.row(y + 1));
-            let inner = 1..width - 1;
-            for (((m, o), (&left, &right)), (&above, &below)) in mag[inner.clone()]
-                .iter_mut()
-                .zip(&mut ori[inner.clone()])
-                .zip(row.iter().zip(&row[2..]))
-                .zip(up[inner.clone()].iter().zip(&down[inner]))
-            {
-                let (dx, dy) = (right - left, below - above);
-                *m = (dx * dx + dy * dy).sqrt();
-                *o = direction(dx, dy);
-            }
+            let rows = (level.row(y - 1), level.row(y), level.row(y + 1));
+            gradient_row_widest(rows, mag, ori);
         });
+}
+
+multiversion! {
+    /// [`gradient_row`] on the widest SIMD the CPU offers (same bits on every path).
+    fn gradient_row_widest(rows: (&[f32], &[f32], &[f32]), mag: &mut [f32], ori: &mut [f32]) => gradient_row
+}
+
+/// One row of [`gradients`]: `rows` are the level's rows above, at and below it.
+#[inline(always)]
+fn gradient_row(rows: (&[f32], &[f32], &[f32]), mag: &mut [f32], ori: &mut [f32]) {
+    let (up, row, down) = rows;
+    let width = row.len();
+    for edge in [0, width - 1] {
+        mag[edge] = 0.0;
+        ori[edge] = 0.0;
+    }
+    let inner = 1..width - 1;
+    for (((m, o), (&left, &right)), (&above, &below)) in mag[inner.clone()]
+        .iter_mut()
+        .zip(&mut ori[inner.clone()])
+        .zip(row.iter().zip(&row[2..]))
+        .zip(up[inner.clone()].iter().zip(&down[inner]))
+    {
+        let (dx, dy) = (right - left, below - above);
+        *m = (dx * dx + dy * dy).sqrt();
+        *o = direction(dx, dy);
+    }
 }
 
 /// `atan2(dy, dx)` in `[0, 2π)` by an odd degree-9 polynomial of `min/max` on `[0, 1]`
 /// (least-squares fit, largest error 1.2·10⁻⁵ rad, 0.0007°; OpenCV's `fastAtan2` errs by up to
 /// ~0.01°); branch-free, so the gradient loop vectorises. `(0, 0)` gives 0.
-#[inline]
+#[inline(always)]
 pub(crate) fn direction(dx: f32, dy: f32) -> f32 {
     const C: [f32; 5] = [
         0.999_866_37,
