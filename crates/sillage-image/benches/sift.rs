@@ -1,5 +1,6 @@
 //! SIFT on a 768×576 frame: `detect_and_describe` (OpenCV's `detectAndCompute`) and 10,000
-//! `describe_at` queries (the particles of SIFT-PF). Run with
+//! `describe_at` queries (the particles of SIFT-PF), at random positions and clustered as
+//! particles are. Run with
 //! `cargo bench -p sillage-image --bench sift`; the frame is PETS09-S2L1 frame 1 from
 //! `../shared/data` (beside the repository), or a seeded textured frame where it is absent.
 
@@ -61,14 +62,29 @@ fn bench_sift(c: &mut Criterion) {
             )
         })
         .collect();
-    group.bench_function("describe_at_10k", |b| {
-        b.iter(|| {
-            queries
-                .iter()
-                .filter_map(|&(x, y, s, o)| sift.describe_at(x, y, s, o))
-                .count()
+    // SIFT-PF's pattern: 100 features of 100 particles each, within ±4 px of the feature.
+    let clustered: Vec<(f32, f32, f32, f32)> = queries
+        .iter()
+        .enumerate()
+        .map(|(i, _)| {
+            let (x, y, s, o) = queries[i / 100 * 100];
+            let t = i as f32;
+            (x + (t * 1.37) % 8.0 - 4.0, y + (t * 2.11) % 8.0 - 4.0, s, o)
         })
-    });
+        .collect();
+    for (name, positions) in [
+        ("describe_at_10k", &queries),
+        ("describe_at_10k_clustered", &clustered),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                positions
+                    .iter()
+                    .filter_map(|&(x, y, s, o)| sift.describe_at(x, y, s, o))
+                    .count()
+            })
+        });
+    }
     group.finish();
 }
 
