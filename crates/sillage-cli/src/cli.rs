@@ -693,6 +693,44 @@ pub enum TrackCommand {
     /// acceleration and a learned motion prior competing (Madrigal & Hayet), on colour frames
     /// or, without frames, on detections alone; writes MOTChallenge results.
     Immpf(TrackImmpfArgs),
+    /// Surveillance objects: SIFT features on motion blobs, each followed by a particle
+    /// filter, objects linked through the features they share, with merges, splits and
+    /// occlusions (Souded et al. 2011); writes MOTChallenge results.
+    Siftpf(TrackSiftpfArgs),
+}
+
+/// `sillage track siftpf`.
+#[derive(Debug, Args)]
+pub struct TrackSiftpfArgs {
+    /// Colour frames (a folder, a quoted glob, a multi-page TIFF or a video).
+    pub input: String,
+    /// MOTChallenge results to write (1-based frames).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Feature selection, the paper's configurations of §3.1.1: whole-object (1),
+    /// detection-order (2), reliability (3, the default).
+    #[arg(long, value_name = "NAME")]
+    pub selection: Option<String>,
+    /// Ground plane (TOML with `[homography]`, from `sillage fit homography`): sizes and
+    /// speeds learned in metres for resuming occluded objects (§2.4); pixels without it.
+    #[arg(long, value_name = "FILE")]
+    pub ground_plane: Option<PathBuf>,
+    /// TOML parameters: `[tracker]` (selection, sift, placement, filter, association,
+    /// validation) and `[motion_detector]`.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Override one key, e.g. `--set tracker.filter.particles=50` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<String>,
+    /// Random seed of the particles.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Stop after this many frames.
+    #[arg(long, value_name = "N")]
+    pub max_frames: Option<usize>,
+    /// Print a machine-readable summary on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// A frame size written `WIDTHxHEIGHT`.

@@ -37,6 +37,12 @@ pub struct GroundPlaneFile {
 }
 
 impl GroundPlaneFile {
+    /// Reads the homography of a ground-plane file.
+    pub fn read_homography(path: &Path) -> Result<Homography> {
+        let file: Self = read_toml_file(path)?;
+        Ok(file.homography)
+    }
+
     /// Reads a ground-plane file and the box sizing it gives: the adult's box at each foot
     /// point; the file must have a `[pedestrian]` table.
     pub fn read_sizing(path: &Path) -> Result<BoxSizing> {

@@ -27,6 +27,7 @@ mod synth_bedload;
 mod synth_walkers;
 mod track;
 mod track_immpf;
+mod track_siftpf;
 
 use clap::Parser;
 
@@ -52,6 +53,7 @@ fn main() {
         cli::Command::Fit(cli::FitCommand::Homography(a)) => fit_pedestrian::run_homography(&a),
         cli::Command::Track(cli::TrackCommand::Bedload(a)) => track::run_bedload(&a),
         cli::Command::Track(cli::TrackCommand::Immpf(a)) => track_immpf::run(&a),
+        cli::Command::Track(cli::TrackCommand::Siftpf(a)) => track_siftpf::run(&a),
         cli::Command::Detect(cli::DetectCommand::Bead(a)) => detect::run_bead(&a),
     };
     if let Err(error) = outcome {

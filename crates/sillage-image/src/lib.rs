@@ -50,6 +50,7 @@ pub mod background;
 pub mod bandpass;
 pub mod box_mean;
 pub mod components;
+pub mod dominant_colours;
 pub mod gaussian;
 pub mod histogram;
 pub mod levels;
@@ -69,6 +70,7 @@ pub use background::BackgroundModel;
 pub use bandpass::{DogFilter, LogFilter, MAX_SCALE_PX, Polarity};
 pub use box_mean::box_mean_3x3;
 pub use components::{Component, ComponentLabeller, PixelBox};
+pub use dominant_colours::{DominantColours, WeightedColour};
 pub use gaussian::{GaussianFilter, GaussianKernel, MAX_SIGMA_PX};
 pub use histogram::{
     BinImage, BoxPx, HsvBinning, MAX_BINS, bhattacharyya_coefficient, bhattacharyya_distance,

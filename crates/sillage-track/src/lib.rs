@@ -33,3 +33,4 @@
 pub mod bedload;
 pub mod immpf;
 pub mod ptv;
+pub mod siftpf;
