@@ -10,14 +10,14 @@ use anyhow::{Context, Result, ensure};
 use rayon::prelude::*;
 use serde::Serialize;
 use sillage::core::{FrameIndex, Point2};
-use sillage::eval::mot::{BoundingBox, MotChallengeProtocol, MotEstimate, Shape};
+use sillage::eval::mot::BoundingBox;
 use sillage::eval::papers::vace;
-use sillage::eval::{MotData, MotParams, evaluate_mot};
+use sillage::eval::{MotParams, evaluate_mot};
 use sillage::filter::{MotionPrior, MotionPriorParams};
 use sillage::track::immpf::{ModelName, PedestrianEstimate, PedestrianParams, PedestrianTracker};
 
-use crate::cli::{BenchImmpfArgs, MatchRule, TrackImmpfArgs};
-use crate::eval_inputs::load_truth;
+use crate::bench_sequence::{SequenceTruth, sequence_name};
+use crate::cli::{BenchImmpfArgs, TrackImmpfArgs};
 use crate::fit_pedestrian::median;
 use crate::pedestrian_input::{PedestrianInput, PreparedFrame, seqinfo_beside};
 use crate::track_immpf::{load_params, load_scene, step};
@@ -61,8 +61,7 @@ struct Sequence {
     name: String,
     frames: Vec<PreparedFrame>,
     frame_size_px: (usize, usize),
-    truth: Vec<sillage::eval::mot::MotTruth>,
-    frame_count: Option<u64>,
+    truth: SequenceTruth,
 }
 
 /// `sillage bench immpf SEQ... [--runs 30]`.
@@ -139,10 +138,6 @@ fn prepare(
     motion: &sillage::detect::motion::MotionParams,
     params: &PedestrianParams,
 ) -> Result<Sequence> {
-    let name = folder
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| folder.display().to_string());
     let detections = folder.join("det").join("det.txt");
     let images = folder.join("img1");
     let use_images = !args.detections_only;
@@ -167,19 +162,11 @@ fn prepare(
     while let Some(frame) = input.next_frame()? {
         frames.push(frame);
     }
-    let (truth, frame_count) = load_truth(
-        &folder.join("gt").join("gt.txt"),
-        MatchRule::Iou { threshold: 0.5 },
-        MotChallengeProtocol::Mot15,
-    )?;
-    let last = frames.len() as u64;
-    let truth = truth.into_iter().filter(|t| t.frame < last).collect();
     Ok(Sequence {
-        name,
+        name: sequence_name(folder),
         frames,
         frame_size_px: input.frame_size_px,
-        truth,
-        frame_count: frame_count.map(|n| n.min(last)),
+        truth: SequenceTruth::load(folder)?,
     })
 }
 
@@ -240,25 +227,18 @@ fn run_once(
     seed: u64,
 ) -> Result<RunScores> {
     let (estimates, ms) = track(sequence, params, sizing, prior, seed)?;
-    let objects: Vec<MotEstimate> = estimates
-        .iter()
-        .map(|e| MotEstimate {
-            frame: e.frame,
-            id: e.track_id,
-            shape: Shape::Box(BoundingBox {
-                left_px: e.bbox.left_px,
-                top_px: e.bbox.top_px,
-                width_px: e.bbox.width_px,
-                height_px: e.bbox.height_px,
-            }),
-        })
-        .collect();
-    let data = MotData::new(
-        &sequence.truth,
-        &objects,
-        MatchRule::Iou { threshold: 0.5 }.similarity(),
-        sequence.frame_count,
-    )?;
+    let boxes = estimates.iter().map(|e| {
+        let bbox = BoundingBox {
+            left_px: e.bbox.left_px,
+            top_px: e.bbox.top_px,
+            width_px: e.bbox.width_px,
+            height_px: e.bbox.height_px,
+        };
+        (e.frame, e.track_id, bbox)
+    });
+    let data = sequence
+        .truth
+        .data(boxes, sequence.frames.len() as u64)?;
     let metrics = evaluate_mot(&data, &MotParams::default())?;
     let v = vace(&data);
     Ok(RunScores {

@@ -489,6 +489,44 @@ pub enum BenchCommand {
     /// sequences, VACE (SFDA, ATA, N-MODP, MOTP), CLEAR MOT, IDF1 and HOTA, medians over
     /// seeds; or, with --detections-only, on detections alone.
     Immpf(BenchImmpfArgs),
+    /// The SIFT-PF paper's evaluation (§3): each feature selection of §3.1.1 on MOTChallenge
+    /// sequences, ETISEO M1-M3 and their mean, CLEAR MOT, IDF1, HOTA and speed, per sequence
+    /// and combined.
+    Siftpf(BenchSiftpfArgs),
+}
+
+/// The paper's three feature selections (§3.1.1), in its order.
+pub const SIFTPF_SELECTIONS: [&str; 3] = ["whole-object", "detection-order", "reliability"];
+
+/// `sillage bench siftpf`.
+#[derive(Debug, Args)]
+pub struct BenchSiftpfArgs {
+    /// MOTChallenge sequence folders: `gt/gt.txt`, `seqinfo.ini`, and the frames in `img1/`
+    /// or, without `img1/`, one video `video/*.mp4`.
+    #[arg(required = true)]
+    pub sequences: Vec<PathBuf>,
+    /// Feature selections, comma-separated (default: the paper's three).
+    #[arg(long, value_delimiter = ',', default_values_t = SIFTPF_SELECTIONS.map(String::from))]
+    pub selections: Vec<String>,
+    /// Use the first N frames of each sequence.
+    #[arg(long, value_name = "N")]
+    pub max_frames: Option<usize>,
+    /// Random seed of the particles (one run per selection: the tracker is deterministic).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Ground plane, as `sillage track siftpf --ground-plane`.
+    #[arg(long, value_name = "FILE")]
+    pub ground_plane: Option<PathBuf>,
+    /// TOML parameters, as `sillage track siftpf --config` (its `selection` is replaced by
+    /// each of --selections).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Override one key (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<String>,
+    /// Print the rows as JSON instead of a Markdown table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// The paper's seven model combinations (Table 1).

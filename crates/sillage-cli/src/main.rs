@@ -8,6 +8,8 @@ mod bench;
 mod bench_bedload;
 mod bench_bedload_plots;
 mod bench_immpf;
+mod bench_sequence;
+mod bench_siftpf;
 mod cli;
 mod demo;
 mod demo_bedload;
@@ -47,6 +49,7 @@ fn main() {
         cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
         cli::Command::Bench(cli::BenchCommand::Bedload(a)) => bench_bedload::run(&a),
         cli::Command::Bench(cli::BenchCommand::Immpf(a)) => bench_immpf::run(&a),
+        cli::Command::Bench(cli::BenchCommand::Siftpf(a)) => bench_siftpf::run(&a),
         cli::Command::Config(a) => ptv::print_config(&a),
         cli::Command::Fit(cli::FitCommand::Bedload(a)) => fit::run_bedload(&a),
         cli::Command::Fit(cli::FitCommand::MotionPrior(a)) => fit_pedestrian::run_motion_prior(&a),

@@ -19,7 +19,7 @@ use crate::ground_plane::GroundPlaneFile;
 use crate::progress::FrameProgress;
 
 /// The `[tracker]` and `[motion_detector]` tables of a configuration file.
-#[derive(Debug, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SiftPfConfig {
     /// The tracker.
@@ -45,9 +45,19 @@ impl SiftPfConfig {
         if let Some(name) = selection {
             loaded.tracker.selection = FeatureSelection::parse(name)?;
         }
-        loaded.tracker.validate()?;
-        loaded.motion_detector.validate()?;
+        loaded.validate()?;
         Ok(loaded)
+    }
+
+    /// Checks both tables; an error names the key as written (`tracker.filter.particles`).
+    pub fn validate(&self) -> Result<()> {
+        self.tracker
+            .validate()
+            .map_err(|e| e.in_section("tracker"))?;
+        self.motion_detector
+            .validate()
+            .map_err(|e| e.in_section("motion_detector"))?;
+        Ok(())
     }
 }
 
@@ -62,6 +72,16 @@ pub struct SiftPfRun {
     pub tracking: Duration,
     /// Wall time of the whole run.
     pub total: Duration,
+}
+
+impl SiftPfRun {
+    /// The number of distinct track identities in the rows.
+    pub fn track_count(&self) -> usize {
+        let mut ids: Vec<u64> = self.rows.iter().filter_map(|r| r.id).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids.len()
+    }
 }
 
 /// Tracks the colour frames of `input` (the first `max_frames`).
@@ -180,14 +200,11 @@ pub fn run(args: &TrackSiftpfArgs) -> Result<()> {
     let mut writer = MotResultsWriter::create(&args.out)?;
     writer.push(&run.rows)?;
     writer.finish()?;
-    let mut ids: Vec<u64> = run.rows.iter().filter_map(|r| r.id).collect();
-    ids.sort_unstable();
-    ids.dedup();
     let per_frame = |d: Duration| 1e3 * d.as_secs_f64() / run.frames as f64;
     let summary = Summary {
         selection: config.tracker.selection.label().to_string(),
         frames: run.frames,
-        tracks: ids.len(),
+        tracks: run.track_count(),
         rows: run.rows.len(),
         ms_per_frame: per_frame(run.total),
         tracking_ms_per_frame: per_frame(run.tracking),
