@@ -236,9 +236,7 @@ fn run_once(
         };
         (e.frame, e.track_id, bbox)
     });
-    let data = sequence
-        .truth
-        .data(boxes, sequence.frames.len() as u64)?;
+    let data = sequence.truth.data(boxes, sequence.frames.len() as u64)?;
     let metrics = evaluate_mot(&data, &MotParams::default())?;
     let v = vace(&data);
     Ok(RunScores {

@@ -136,8 +136,9 @@ pub fn run(args: &BenchSiftpfArgs) -> Result<()> {
             let mut config = config.clone();
             config.tracker.selection = selection;
             config.validate()?;
-            let tally = run_once(sequence, &config, homography, args)
-                .with_context(|| format!("{} ({})", sequence.folder.display(), selection.label()))?;
+            let tally = run_once(sequence, &config, homography, args).with_context(|| {
+                format!("{} ({})", sequence.folder.display(), selection.label())
+            })?;
             let row = Row::new(&sequence.name, selection, &tally);
             eprintln!("{}", format_row(&row));
             rows.push(row);

@@ -45,7 +45,10 @@ fn a_walkers_crossing_is_tracked_and_benched() {
     let rows = read_mot_rows(&out).unwrap();
     let ids: BTreeSet<u64> = rows.iter().map(|r| r.id.unwrap()).collect();
     assert!(!ids.is_empty(), "no identity in {}", out.display());
-    assert!(rows.iter().all(|r| r.frame < FRAMES), "a row beyond the sequence");
+    assert!(
+        rows.iter().all(|r| r.frame < FRAMES),
+        "a row beyond the sequence"
+    );
     assert!(
         rows.iter().all(|r| r.width_px > 0.0 && r.height_px > 0.0),
         "an empty box"
@@ -80,7 +83,10 @@ fn a_walkers_crossing_is_tracked_and_benched() {
         score("id_confusion"),
     ];
     assert!(m.iter().all(|v| (0.0..=1.0).contains(v)), "{row}");
-    assert!((score("mean") - (m[0] + m[1] + m[2]) / 3.0).abs() < 1e-12, "{row}");
+    assert!(
+        (score("mean") - (m[0] + m[1] + m[2]) / 3.0).abs() < 1e-12,
+        "{row}"
+    );
     for key in ["mota", "idf1", "hota", "tracking_ms_per_frame", "fps"] {
         assert!(score(key).is_finite(), "{key}: {row}");
     }
@@ -88,7 +94,13 @@ fn a_walkers_crossing_is_tracked_and_benched() {
     let combined = report["combined"].as_array().unwrap();
     assert_eq!(combined.len(), 1, "{report}");
     assert_eq!(combined[0]["sequence"], "COMBINED");
-    for key in ["tracking_time", "id_persistence", "id_confusion", "mean", "mota"] {
+    for key in [
+        "tracking_time",
+        "id_persistence",
+        "id_confusion",
+        "mean",
+        "mota",
+    ] {
         assert_eq!(combined[0][key], row[key], "{key}");
     }
 }
@@ -115,14 +127,11 @@ fn bad_options_and_folders_are_refused_with_the_problem_named() {
     );
     let message = track(&["--set", "tracker.filter.particles=0"]);
     assert!(message.contains("tracker.filter.particles"), "{message}");
-    let message = run_user_error(&[
-        "bench",
-        "siftpf",
-        path_str(&empty),
-        "--selections",
-        "best",
-    ]);
-    assert!(message.contains("best") && message.contains("reliability"), "{message}");
+    let message = run_user_error(&["bench", "siftpf", path_str(&empty), "--selections", "best"]);
+    assert!(
+        message.contains("best") && message.contains("reliability"),
+        "{message}"
+    );
 
     // A sequence folder with its truth but no frames.
     let seq = dir.path().join("no-frames");
