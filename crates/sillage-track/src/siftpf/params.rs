@@ -57,7 +57,9 @@ impl FeatureSelection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FeatureFilterParams {
-    /// Particles per feature (a constant number, §2.2.2); default 30.
+    /// Particles per feature (a constant number, §2.2.2; the paper gives none); default 15
+    /// (30 tracked PETS 2009 and the generated walkers no better at twice the time,
+    /// docs/siftpf.md).
     pub particles: usize,
     /// σ of the position noise `n_(x,y)` of Eq. (3), px; default 1.5.
     pub position_noise_px: f64,
@@ -82,7 +84,7 @@ pub struct FeatureFilterParams {
 impl Default for FeatureFilterParams {
     fn default() -> Self {
         Self {
-            particles: 30,
+            particles: 15,
             position_noise_px: 1.5,
             velocity_noise_px_per_frame: 0.7,
             initial_sigma: 0.2,
@@ -101,7 +103,8 @@ pub struct FeaturePlacementParams {
     /// Side of a sub-region, px: a box of `w × h` has `round(w/s) × round(h/s)` (at least one);
     /// default 12.
     pub subregion_px: f64,
-    /// Features per sub-region; default 2.
+    /// Features per sub-region (constant, §2.1; the paper gives no number); default 1 (2
+    /// doubled the time for no gain on PETS 2009).
     pub features_per_subregion: usize,
     /// Two features closer than this are one too many: the less reliable is replaced
     /// (§2.3, "filtering out too close features"); default 3 px.
@@ -112,7 +115,7 @@ impl Default for FeaturePlacementParams {
     fn default() -> Self {
         Self {
             subregion_px: 12.0,
-            features_per_subregion: 2,
+            features_per_subregion: 1,
             min_spacing_px: 3.0,
         }
     }
@@ -200,7 +203,10 @@ pub struct SiftPfParams {
     /// Which features are tracked; default the paper's configuration 3.
     pub selection: FeatureSelection,
     /// The permissive SIFT detector of configurations 2 and 3 (contrast 0.005, edge 7.5,
-    /// §3.1.1); configuration 1 uses Lowe's thresholds with this detector's other values.
+    /// §3.1.1), without Lowe's doubling of the first octave: people at surveillance
+    /// resolution carry features of σ ≥ 1.6 px, and the doubled octave quadruples the
+    /// pyramid for no gain on PETS 2009 (docs/siftpf.md). Configuration 1 uses Lowe's
+    /// thresholds with this detector's other values.
     pub sift: SiftParams,
     /// Feature placement (§2.1).
     pub placement: FeaturePlacementParams,
@@ -216,7 +222,10 @@ impl Default for SiftPfParams {
     fn default() -> Self {
         Self {
             selection: FeatureSelection::Reliability,
-            sift: SiftParams::permissive(),
+            sift: SiftParams {
+                upsample: false,
+                ..SiftParams::permissive()
+            },
             placement: FeaturePlacementParams::default(),
             filter: FeatureFilterParams::default(),
             association: AssociationParams::default(),

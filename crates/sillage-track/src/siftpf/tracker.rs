@@ -369,11 +369,7 @@ impl SiftPfTracker {
         }
         self.replenish(i, input, &others);
         let object = &mut self.objects[i];
-        object.signature = object
-            .features
-            .iter()
-            .map(|f| *f.descriptor())
-            .collect();
+        object.signature = object.features.iter().map(|f| *f.descriptor()).collect();
     }
 
     /// Adds features to the sub-regions of object `i` that lack them (§2.1, §2.3).
@@ -542,11 +538,7 @@ impl SiftPfTracker {
             }
             object.coherence.learn(self.scale.size(&object.bbox), None);
             object.last_ground = Some((self.scale.ground(&object.bbox), input.frame));
-            object.signature = object
-                .features
-                .iter()
-                .map(|f| *f.descriptor())
-                .collect();
+            object.signature = object.features.iter().map(|f| *f.descriptor()).collect();
         }
     }
 
