@@ -90,7 +90,8 @@ pub use mot::{
 pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
 pub use tracks::{
     STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackLayout,
-    TrackTable, TrackWriter, WrittenSummary, create_track_writer, read_track_table, read_tracks,
+    TrackTable, TrackWriter, WrittenSummary, create_track_writer, for_each_track_point,
+    read_track_table, read_tracks,
 };
 pub use tractrac_par::{
     TRACTRAC_KEYS, TractracPar, parse_tractrac_par, read_tractrac_par, write_tractrac_par,

@@ -3,6 +3,8 @@
 //! the file, line and column of every error, and number formatting.
 
 use std::fmt::Write as _;
+use std::fs::File;
+use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use sillage_core::{Error, Result};
@@ -71,11 +73,11 @@ pub(crate) fn push_f64(out: &mut String, value: f64) {
 
 /// A CSV file with a header row, read with every column looked up by name.
 ///
-/// The file is held in memory so that errors can name the true line of a row (the `csv`
-/// crate's own line count skips blank lines).
+/// Rows are streamed from the file (memory does not grow with its length); an error's line
+/// is found by scanning the file again up to the row (the `csv` crate's own line count
+/// skips blank lines).
 pub(crate) struct CsvTable {
     path: PathBuf,
-    content: Vec<u8>,
     /// For each wanted column, its index in the file (None: optional and absent).
     indices: Vec<Option<usize>>,
     names: Vec<&'static str>,
@@ -87,11 +89,11 @@ pub(crate) struct CsvRow<'a> {
     record: &'a csv::StringRecord,
 }
 
-fn csv_reader(content: &[u8]) -> csv::Reader<&[u8]> {
+fn csv_reader<R: Read>(source: R) -> csv::Reader<R> {
     csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
-        .from_reader(content)
+        .from_reader(source)
 }
 
 impl CsvTable {
@@ -103,14 +105,12 @@ impl CsvTable {
         optional: &[&'static str],
         expected: &str,
     ) -> Result<Self> {
-        let content = std::fs::read(path).map_err(|e| Error::io(path, e))?;
         let mut table = Self {
             path: path.to_path_buf(),
-            content,
             indices: Vec::new(),
             names: required.iter().chain(optional).copied().collect(),
         };
-        let mut reader = csv_reader(&table.content);
+        let mut reader = csv_reader(table.open_file()?);
         let header = reader.headers().map_err(|e| table.csv_error(&e))?.clone();
         let find = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
         for &name in required {
@@ -137,7 +137,7 @@ impl CsvTable {
         &self,
         mut each: impl FnMut(&CsvRow<'_>) -> Result<()>,
     ) -> Result<()> {
-        let mut reader = csv_reader(&self.content);
+        let mut reader = csv_reader(self.open_file()?);
         let mut record = csv::StringRecord::new();
         loop {
             match reader.read_record(&mut record) {
@@ -151,28 +151,39 @@ impl CsvTable {
         }
     }
 
+    fn open_file(&self) -> Result<BufReader<File>> {
+        let file = File::open(&self.path).map_err(|e| Error::io(&self.path, e))?;
+        Ok(BufReader::with_capacity(1 << 16, file))
+    }
+
     /// The 1-based line of the record the reader started at `byte` (its position includes
-    /// the blank and comment lines skipped before the record).
-    fn line_at(&self, byte: u64) -> usize {
-        let content = &self.content;
-        let mut at = usize::try_from(byte).map_or(content.len(), |b| b.min(content.len()));
-        while let Some(&b) = content.get(at) {
-            match b {
-                b'\n' | b'\r' => at += 1,
-                b'#' => {
-                    at += content[at..]
-                        .iter()
-                        .position(|&b| b == b'\n')
-                        .map_or(content.len() - at, |p| p + 1);
+    /// the blank and comment lines skipped before the record). Reads the file again up to
+    /// the record: only errors need it.
+    fn line_at(&self, byte: u64) -> Option<usize> {
+        let mut bytes = self.open_file().ok()?.bytes();
+        let mut newlines = 0;
+        for _ in 0..byte {
+            newlines += usize::from(bytes.next()?.ok()? == b'\n');
+        }
+        // Skip the blank and comment lines the reader skipped.
+        let mut in_comment = false;
+        for b in bytes {
+            match b.ok()? {
+                b'\n' => {
+                    newlines += 1;
+                    in_comment = false;
                 }
+                b'\r' => {}
+                b'#' => in_comment = true,
+                _ if in_comment => {}
                 _ => break,
             }
         }
-        content[..at].iter().filter(|&&b| b == b'\n').count() + 1
+        Some(newlines + 1)
     }
 
     fn csv_error(&self, error: &csv::Error) -> Error {
-        let line = error.position().map(|p| self.line_at(p.byte()));
+        let line = error.position().and_then(|p| self.line_at(p.byte()));
         let message = match error.kind() {
             csv::ErrorKind::UnequalLengths {
                 expected_len, len, ..
@@ -190,7 +201,10 @@ impl CsvTable {
 impl CsvRow<'_> {
     /// An error at this row's line.
     pub(crate) fn error(&self, message: impl Into<String>) -> Error {
-        let line = self.record.position().map(|p| self.table.line_at(p.byte()));
+        let line = self
+            .record
+            .position()
+            .and_then(|p| self.table.line_at(p.byte()));
         Error::format(&self.table.path, line, message)
     }
 

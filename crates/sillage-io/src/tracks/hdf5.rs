@@ -14,7 +14,7 @@ use sillage_core::{Error, MotionState, Result, TrackPoint, TrackSink};
 
 use super::column_buffer::TrackColumns;
 use super::columns::{STATE_COLUMNS, TRACK_COLUMNS, TrackLayout};
-use super::{TrackFileHeader, TrackTable, TrackWriter, WrittenSummary};
+use super::{TrackFileHeader, TrackWriter, WrittenSummary};
 use crate::partial::partial_path;
 
 /// Rows buffered before the datasets are extended.
@@ -191,7 +191,10 @@ fn write_text_attribute(location: &hdf5::Location, name: &str, value: &str) -> h
 /// Reads an HDF5 track table written by [`Hdf5TrackWriter`] (datasets named as
 /// [`TRACK_COLUMNS`] and [`STATE_COLUMNS`]; all but frame, particle, x and y optional). The
 /// layout is [`TrackLayout::WithStates`] when the file has a `motion_state` dataset.
-pub(crate) fn read_hdf5(path: &Path) -> Result<TrackTable> {
+pub(crate) fn read_hdf5(
+    path: &Path,
+    each: &mut dyn FnMut(TrackPoint) -> Result<()>,
+) -> Result<TrackLayout> {
     std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     let file = hdf5::File::open(path).map_err(|e| hdf5_error(path, "open", e))?;
     let read = |name: &str| -> Result<Option<Vec<f64>>> {
@@ -297,6 +300,8 @@ pub(crate) fn read_hdf5(path: &Path) -> Result<TrackTable> {
         }
     }
     columns.spread_px = optional(spread)?;
-    let points = columns.to_points(path, 1)?;
-    Ok(TrackTable { points, layout })
+    for point in columns.to_points(path, 1)? {
+        each(point)?;
+    }
+    Ok(layout)
 }

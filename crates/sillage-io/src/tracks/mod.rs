@@ -175,15 +175,33 @@ pub fn read_tracks(path: &Path, format: TrackFormat) -> Result<Vec<TrackPoint>> 
 
 /// Reads a whole track table of `format` at `path`, with the layout its columns had.
 pub fn read_track_table(path: &Path, format: TrackFormat) -> Result<TrackTable> {
+    let mut points = Vec::new();
+    let layout = for_each_track_point(path, format, |point| {
+        points.push(point);
+        Ok(())
+    })?;
+    Ok(TrackTable { points, layout })
+}
+
+/// Streams the points of the track table of `format` at `path` to `each`, in file order,
+/// and returns the layout of its columns. Memory does not grow with the table's length
+/// (TracTrac and CSV: row by row; Parquet: one record batch at a time), except for HDF5,
+/// whose datasets are read whole. The first error of `each` stops the reading.
+pub fn for_each_track_point(
+    path: &Path,
+    format: TrackFormat,
+    mut each: impl FnMut(TrackPoint) -> Result<()>,
+) -> Result<TrackLayout> {
+    let each: &mut dyn FnMut(TrackPoint) -> Result<()> = &mut each;
     match format {
-        TrackFormat::Tractrac => text::read_tractrac(path),
-        TrackFormat::Csv => text::read_csv(path),
+        TrackFormat::Tractrac => text::read_tractrac(path, each),
+        TrackFormat::Csv => text::read_csv(path, each),
         #[cfg(feature = "parquet")]
-        TrackFormat::Parquet => parquet::read_parquet(path),
+        TrackFormat::Parquet => parquet::read_parquet(path, each),
         #[cfg(not(feature = "parquet"))]
         TrackFormat::Parquet => Err(not_built(format)),
         #[cfg(feature = "hdf5")]
-        TrackFormat::Hdf5 => hdf5::read_hdf5(path),
+        TrackFormat::Hdf5 => hdf5::read_hdf5(path, each),
         #[cfg(not(feature = "hdf5"))]
         TrackFormat::Hdf5 => Err(not_built(format)),
     }

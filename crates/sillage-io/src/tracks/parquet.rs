@@ -22,7 +22,7 @@ use sillage_core::{Error, MotionState, Result, TrackPoint, TrackSink};
 
 use super::column_buffer::TrackColumns;
 use super::columns::{STATE_COLUMNS, TRACK_COLUMNS, TrackLayout};
-use super::{TrackFileHeader, TrackTable, TrackWriter, WrittenSummary};
+use super::{TrackFileHeader, TrackWriter, WrittenSummary};
 use crate::partial::PartialFile;
 
 /// Rows buffered before a row group is written.
@@ -168,12 +168,15 @@ impl TrackWriter for ParquetTrackWriter {
 /// Reads a Parquet track table. `frame`, `particle`, `x`, `y` are required; integer and
 /// float columns of other widths are converted. The layout is [`TrackLayout::WithStates`]
 /// when the table has a `motion_state` column.
-pub(crate) fn read_parquet(path: &Path) -> Result<TrackTable> {
+pub(crate) fn read_parquet(
+    path: &Path,
+    each: &mut dyn FnMut(TrackPoint) -> Result<()>,
+) -> Result<TrackLayout> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
     let reader = ParquetRecordBatchReaderBuilder::try_new(file)
         .and_then(|b| b.build())
         .map_err(|e| parquet_error(path, "read", e))?;
-    let mut points = Vec::new();
+    let mut rows_read = 0;
     let mut layout = TrackLayout::Kinematics;
     let mut columns = TrackColumns::default();
     for batch in reader {
@@ -233,7 +236,7 @@ pub(crate) fn read_parquet(path: &Path) -> Result<TrackTable> {
         }
         if let Some(array) = column(motion_state, &DataType::Utf8)? {
             layout = TrackLayout::WithStates;
-            let first_row = points.len() + 1;
+            let first_row = rows_read + 1;
             for (i, name) in array.as_string::<i32>().iter().enumerate() {
                 columns.motion_state[i] = match name {
                     None => MotionState::Unknown,
@@ -254,9 +257,12 @@ pub(crate) fn read_parquet(path: &Path) -> Result<TrackTable> {
         if let Some(array) = column(spread, &DataType::Float64)? {
             columns.spread_px = array.as_primitive::<Float64Type>().iter().collect();
         }
-        points.extend(columns.to_points(path, points.len() + 1)?);
+        for point in columns.to_points(path, rows_read + 1)? {
+            each(point)?;
+        }
+        rows_read += batch.num_rows();
     }
-    Ok(TrackTable { points, layout })
+    Ok(layout)
 }
 
 fn no_nulls(path: &Path, name: &str, array: &ArrayRef) -> Result<()> {

@@ -11,7 +11,7 @@ use super::columns::{
     STATE_COLUMNS, TRACK_COLUMNS, TrackLayout, check_position, class_from_value, kinematics,
     point_from_values,
 };
-use super::{TrackFileHeader, TrackTable, TrackWriter, WrittenSummary};
+use super::{TrackFileHeader, TrackWriter, WrittenSummary};
 use crate::text_table::{CsvTable, RowWriter, parse_index, push_opt};
 
 /// The column line of TracTrac's `_track.txt` (its third header line, after `#  `).
@@ -131,9 +131,11 @@ impl TrackWriter for TextTrackWriter {
 
 /// Reads TracTrac's `_track.txt`: `#` lines skipped, 11 space-separated columns, `nan` for
 /// unknown kinematics.
-pub(crate) fn read_tractrac(path: &Path) -> Result<TrackTable> {
+pub(crate) fn read_tractrac(
+    path: &Path,
+    each: &mut dyn FnMut(TrackPoint) -> Result<()>,
+) -> Result<TrackLayout> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut points = Vec::new();
     for (i, line) in std::io::BufReader::new(file).lines().enumerate() {
         let line_no = i + 1;
         let line = line.map_err(|e| {
@@ -143,18 +145,15 @@ pub(crate) fn read_tractrac(path: &Path) -> Result<TrackTable> {
         if text.is_empty() || text.starts_with('#') {
             continue;
         }
-        points.push(parse_tractrac_row(text).map_err(|message| {
+        each(parse_tractrac_row(text).map_err(|message| {
             Error::format(
                 path,
                 Some(line_no),
                 format!("{message}; a row is `{TRACTRAC_COLUMNS_LINE}` (11 numbers)"),
             )
-        })?);
+        })?)?;
     }
-    Ok(TrackTable {
-        points,
-        layout: TrackLayout::Kinematics,
-    })
+    Ok(TrackLayout::Kinematics)
 }
 
 fn parse_tractrac_row(text: &str) -> std::result::Result<TrackPoint, String> {
@@ -192,7 +191,10 @@ fn parse_tractrac_row(text: &str) -> std::result::Result<TrackPoint, String> {
 /// Reads a CSV track table (columns found by name; the kinematic and state ones are
 /// optional, so a trackpy `frame,particle,x,y` table is read too). The layout is
 /// [`TrackLayout::WithStates`] when the table has a `motion_state` column.
-pub(crate) fn read_csv(path: &Path) -> Result<TrackTable> {
+pub(crate) fn read_csv(
+    path: &Path,
+    each: &mut dyn FnMut(TrackPoint) -> Result<()>,
+) -> Result<TrackLayout> {
     let [frame, particle, x, y, kinematic @ ..] = TRACK_COLUMNS;
     let optional: Vec<&'static str> = kinematic.iter().chain(&STATE_COLUMNS).copied().collect();
     let table = CsvTable::open(
@@ -202,7 +204,6 @@ pub(crate) fn read_csv(path: &Path) -> Result<TrackTable> {
         &TrackLayout::WithStates.columns().join(","),
     )?;
     let [class, motion_state, spread] = [11, 12, 13];
-    let mut points = Vec::new();
     table.for_each_row(|row| {
         let pos = Point2::new(row.finite(2)?, row.finite(3)?);
         let mut rest = [None; 7];
@@ -222,15 +223,13 @@ pub(crate) fn read_csv(path: &Path) -> Result<TrackTable> {
             })?;
         }
         point.spread_px = row.optional(spread)?.filter(|s| s.is_finite());
-        points.push(point);
-        Ok(())
+        each(point)
     })?;
-    let layout = if table.has(motion_state) {
+    Ok(if table.has(motion_state) {
         TrackLayout::WithStates
     } else {
         TrackLayout::Kinematics
-    };
-    Ok(TrackTable { points, layout })
+    })
 }
 
 #[cfg(test)]
