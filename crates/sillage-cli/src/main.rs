@@ -14,6 +14,8 @@ mod cli;
 mod demo;
 mod demo_bedload;
 mod detect;
+mod eulerian;
+mod eulerian_plots;
 mod eval;
 mod eval_inputs;
 mod eval_mot;
@@ -58,6 +60,7 @@ fn main() {
         cli::Command::Track(cli::TrackCommand::Immpf(a)) => track_immpf::run(&a),
         cli::Command::Track(cli::TrackCommand::Siftpf(a)) => track_siftpf::run(&a),
         cli::Command::Detect(cli::DetectCommand::Bead(a)) => detect::run_bead(&a),
+        cli::Command::Eulerian(a) => eulerian::run(&a),
     };
     if let Err(error) = outcome {
         eprintln!("error: {error:#}");

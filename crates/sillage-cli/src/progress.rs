@@ -40,3 +40,38 @@ impl FrameProgress {
         self.bar.finish_and_clear();
     }
 }
+
+/// A spinner counting the rows of a table read in one pass (its length is unknown).
+pub struct RowProgress {
+    bar: ProgressBar,
+    rows: u64,
+}
+
+impl RowProgress {
+    /// Rows between two redraws: drawing per row would cost more than the work.
+    const STEP: u64 = 1 << 16;
+
+    /// A spinner labelled `what`.
+    pub fn new(what: &str) -> Self {
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+        if let Ok(style) =
+            ProgressStyle::with_template(&format!("{what} {{spinner}} {{pos}} rows {{per_sec}}"))
+        {
+            bar.set_style(style);
+        }
+        Self { bar, rows: 0 }
+    }
+
+    /// Counts one row.
+    pub fn tick(&mut self) {
+        self.rows += 1;
+        if self.rows.is_multiple_of(Self::STEP) {
+            self.bar.set_position(self.rows);
+        }
+    }
+
+    /// Clears the spinner.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}

@@ -26,6 +26,7 @@
 //! ```
 
 pub mod detection;
+pub mod eulerian;
 mod matching;
 pub mod mot;
 pub mod papers;

@@ -63,6 +63,7 @@ mod frames;
 mod matrix;
 mod mot;
 mod mot_events;
+mod numeric_table;
 mod partial;
 mod text_table;
 mod tracks;
@@ -88,6 +89,7 @@ pub use mot::{
     write_mot_results, write_seqinfo,
 };
 pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
+pub use numeric_table::{ColumnValues, NumericFormat, NumericTable, write_numeric_table};
 pub use tracks::{
     STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackLayout,
     TrackTable, TrackWriter, WrittenSummary, create_track_writer, for_each_track_point,

@@ -2,6 +2,7 @@
 //!
 //! - [`Figure`] of [`GroupedChart`]s: categories along x, grouped bars on a left scale and
 //!   curves on a right scale — the MMPF+ paper's Fig. 6 and Fig. 7 — as PNG pixels or SVG;
+//! - [`Heatmap`]: a field on a grid as coloured cells with a colour bar (Eulerian maps);
 //! - [`draw_overlay`]: a frame with its detections circled and track tails coloured by motion
 //!   state, with ids, from a [`TrackHistory`];
 //! - [`draw_pedestrians`]: tracked people's boxes with the bar of their motion-model weights
@@ -29,13 +30,15 @@
 
 mod chart;
 mod font;
+mod heatmap;
 mod history;
 mod overlay;
 mod palette;
 mod pedestrians;
 
 pub use chart::{Figure, GroupedChart, Series, ValueAxis};
+pub use heatmap::{HeatCell, Heatmap};
 pub use history::TrackHistory;
 pub use overlay::{OverlayStyle, draw_overlay};
-pub use palette::{model_rgb, state_rgb};
+pub use palette::{model_rgb, state_rgb, viridis_rgb};
 pub use pedestrians::{PedestrianTrails, PersonOverlay, TrailPoint, draw_pedestrians};

@@ -54,3 +54,31 @@ pub fn model_rgb(name: &str, position: usize) -> [u8; 3] {
         }
     }
 }
+
+/// Viridis (matplotlib's perceptually uniform colormap) sampled at nine evenly spaced
+/// points, dark blue to yellow.
+const VIRIDIS: [[u8; 3]; 9] = [
+    [68, 1, 84],
+    [71, 44, 122],
+    [59, 81, 139],
+    [44, 113, 142],
+    [33, 144, 141],
+    [39, 173, 129],
+    [92, 200, 99],
+    [170, 220, 50],
+    [253, 231, 37],
+];
+
+/// The viridis colour of `t` in [0, 1] (clamped; NaN reads 0), linearly interpolated
+/// between the nine samples: for values on a scale (speeds, densities), readable in grey
+/// and by colour-blind readers.
+pub fn viridis_rgb(t: f64) -> [u8; 3] {
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let position = t * (VIRIDIS.len() - 1) as f64;
+    let below = (position.floor() as usize).min(VIRIDIS.len() - 2);
+    let fraction = position - below as f64;
+    let (a, b) = (VIRIDIS[below], VIRIDIS[below + 1]);
+    std::array::from_fn(|k| {
+        (f64::from(a[k]) + (f64::from(b[k]) - f64::from(a[k])) * fraction).round() as u8
+    })
+}
