@@ -30,11 +30,17 @@ struct BenchRow {
 }
 
 /// Peak resident memory of this process so far (Linux `VmHWM`), MiB.
-fn peak_rss_mib() -> Option<f64> {
+pub(crate) fn peak_rss_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib / 1024.0)
+}
+
+/// Resets the peak resident memory to the current one (Linux ≥ 4.0, `clear_refs` 5), so
+/// that the next [`peak_rss_mib`] measures what ran in between; false where unsupported.
+pub(crate) fn reset_peak_rss() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
 }
 
 /// Current resident memory of this process (Linux `VmRSS`), MiB.

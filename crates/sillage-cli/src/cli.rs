@@ -338,6 +338,23 @@ pub enum AxisArg {
     Y,
 }
 
+/// `sillage bench eulerian`.
+#[derive(Debug, Args)]
+pub struct BenchEulerianArgs {
+    /// Table lengths to bin, rows, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![100_000, 1_000_000, 10_000_000])]
+    pub rows: Vec<u64>,
+    /// Format of the generated tables.
+    #[arg(long, value_enum, default_value = "csv")]
+    pub format: FormatArg,
+    /// Folder for the generated tables (each deleted after its run).
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    pub dir: PathBuf,
+    /// Print the table as JSON lines on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
 /// `sillage eval ptv`.
 #[derive(Debug, Args)]
 pub struct EvalPtvArgs {
@@ -581,6 +598,8 @@ pub struct DemoBedloadArgs {
 pub enum BenchCommand {
     /// Detection and tracking time per frame on synthetic vortex frames.
     Ptv(BenchPtvArgs),
+    /// `sillage eulerian`'s speed and peak memory on generated track tables of growing length.
+    Eulerian(BenchEulerianArgs),
     /// The MMPF+ paper's evaluation: Table 1 (the five bedload trackers) and the τ_t sweep of
     /// Fig. 6 on a rendered synthetic sequence and, with --real, on a real one; --plots draws
     /// Figs. 6 and 7.

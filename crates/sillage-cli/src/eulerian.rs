@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use sillage::core::{Calibration, Point2};
 use sillage::eval::eulerian::{BinStats, EulerianGrid, GridParams, ProfileAxis};
-use sillage::io::{ColumnValues, NumericTable, for_each_track_point, write_numeric_table};
+use sillage::io::{
+    ColumnValues, NumericTable, TrackFormat, for_each_track_point, write_numeric_table,
+};
 
 use crate::cli::{AxisArg, BinSizeArg, EulerianArgs};
 use crate::progress::RowProgress;
@@ -17,7 +19,8 @@ use crate::ptv::output_format;
 /// Runs `sillage eulerian`.
 pub fn run(args: &EulerianArgs) -> Result<()> {
     let params = grid_params(args)?;
-    let grid = accumulate(args, params)?;
+    let format = output_format(args.format, &args.tracks)?;
+    let grid = accumulate(&args.tracks, format, params)?;
     if grid.rows() == 0 {
         bail!(
             "{}: the table has no rows; nothing to bin",
@@ -68,16 +71,19 @@ fn grid_params(args: &EulerianArgs) -> Result<GridParams> {
     Ok(params)
 }
 
-/// One pass over the rows of the track table.
-fn accumulate(args: &EulerianArgs, params: GridParams) -> Result<EulerianGrid> {
-    let format = output_format(args.format, &args.tracks)?;
+/// One pass over the rows of the track table at `path`.
+pub(crate) fn accumulate(
+    path: &Path,
+    format: TrackFormat,
+    params: GridParams,
+) -> Result<EulerianGrid> {
     let mut grid = EulerianGrid::new(params)?;
     let mut progress = RowProgress::new("binning");
-    for_each_track_point(&args.tracks, format, |point| {
+    for_each_track_point(path, format, |point| {
         progress.tick();
         grid.push(&point)
     })
-    .with_context(|| format!("reading {}", args.tracks.display()))?;
+    .with_context(|| format!("reading {}", path.display()))?;
     progress.finish();
     Ok(grid)
 }

@@ -7,6 +7,7 @@ mod bead_output;
 mod bench;
 mod bench_bedload;
 mod bench_bedload_plots;
+mod bench_eulerian;
 mod bench_immpf;
 mod bench_sequence;
 mod bench_siftpf;
@@ -49,6 +50,7 @@ fn main() {
             None => demo::run(&a),
         },
         cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
+        cli::Command::Bench(cli::BenchCommand::Eulerian(a)) => bench_eulerian::run(&a),
         cli::Command::Bench(cli::BenchCommand::Bedload(a)) => bench_bedload::run(&a),
         cli::Command::Bench(cli::BenchCommand::Immpf(a)) => bench_immpf::run(&a),
         cli::Command::Bench(cli::BenchCommand::Siftpf(a)) => bench_siftpf::run(&a),

@@ -89,9 +89,10 @@ pub(crate) struct CsvRow<'a> {
     record: &'a csv::StringRecord,
 }
 
+/// A reader that skips `#` comment lines. Fields are trimmed where they are read
+/// ([`CsvRow::text`]): the reader's own trimming rebuilds every record.
 fn csv_reader<R: Read>(source: R) -> csv::Reader<R> {
     csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
         .comment(Some(b'#'))
         .from_reader(source)
 }
@@ -112,7 +113,11 @@ impl CsvTable {
         };
         let mut reader = csv_reader(table.open_file()?);
         let header = reader.headers().map_err(|e| table.csv_error(&e))?.clone();
-        let find = |name: &str| header.iter().position(|h| h.eq_ignore_ascii_case(name));
+        let find = |name: &str| {
+            header
+                .iter()
+                .position(|h| h.trim().eq_ignore_ascii_case(name))
+        };
         for &name in required {
             let index = find(name).ok_or_else(|| {
                 Error::format(
@@ -208,10 +213,11 @@ impl CsvRow<'_> {
         Error::format(&self.table.path, line, message)
     }
 
-    /// Wanted column `column` as text; `None` when empty or absent.
+    /// Wanted column `column` as text, trimmed; `None` when empty or absent.
     pub(crate) fn text(&self, column: usize) -> Option<&str> {
         self.table.indices[column]
             .and_then(|i| self.record.get(i))
+            .map(str::trim)
             .filter(|t| !t.is_empty())
     }
 
