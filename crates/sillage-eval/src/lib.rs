@@ -6,6 +6,8 @@
 //! - [`ptv_accuracy`]: the four accuracy indexes of the TracTrac paper (§4.1.2, Fig. 4):
 //!   true and false recovery rates, mean position and displacement errors.
 //! - [`detection_scores`]: recall, precision and localisation error of a detector.
+//! - [`eulerian`]: tracks binned on a grid in one streaming pass — mean velocity, Reynolds
+//!   stresses, turbulent kinetic energy, concentration, profiles (TracTrac §5.1).
 //! - [`papers`]: each paper's own scores — MMPF+ correct tracks and motion-state F-scores,
 //!   IMM-PF's VACE (SFDA, ATA, N-MODP, MOTP), SIFT-PF's ETISEO M1–M3 — on the same matching.
 //!

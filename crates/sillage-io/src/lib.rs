@@ -9,7 +9,9 @@
 //! - [`create_track_writer`] gives a [`TrackWriter`], a [`sillage_core::TrackSink`] that
 //!   streams points into a file (with classes and motion states in the
 //!   [`TrackLayout::WithStates`] columns); [`read_tracks`] / [`read_track_table`] read one
-//!   back;
+//!   back, [`for_each_track_point`] streams one row by row (memory independent of length);
+//! - [`write_numeric_table`] writes a small [`NumericTable`] of statistics as CSV, Parquet
+//!   or NumPy `.npy`;
 //! - [`TruthCsvWriter`] / [`read_truth_csv`], [`DetectionsCsvWriter`] /
 //!   [`read_detections_csv`] for ground truth and saved detections;
 //! - [`read_tractrac_par`] / [`write_tractrac_par`] for TracTrac's `*_par.txt`;
