@@ -6,7 +6,7 @@ use std::path::Path;
 use sillage_core::{MotionState, Point2, TrackPoint, Vec2};
 use sillage_io::{
     TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackLayout, create_track_writer,
-    read_track_table, read_tracks,
+    for_each_track_point, read_track_table, read_tracks,
 };
 
 fn sample_points(n: u64) -> Vec<TrackPoint> {
@@ -252,6 +252,38 @@ fn trackpy_style_csv_without_kinematics_is_read() {
     std::fs::write(&path, "y,x,frame,particle\n3.5,2.25,4,9\n").unwrap();
     let points = read_tracks(&path, TrackFormat::Csv).unwrap();
     assert_eq!(points, vec![TrackPoint::at(4, 9, Point2::new(2.25, 3.5))]);
+}
+
+#[test]
+fn csv_fields_and_names_padded_with_spaces_are_read_and_streamed() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("padded.csv");
+    std::fs::write(
+        &path,
+        " frame , particle,x ,y, vx\n# a comment\n 4 , 9,2.25 , 3.5,  \n5,9, 3 ,4 , 0.75\n",
+    )
+    .unwrap();
+    let mut streamed = Vec::new();
+    let layout = for_each_track_point(&path, TrackFormat::Csv, |p| {
+        streamed.push(p);
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(layout, TrackLayout::Kinematics);
+    let mut second = TrackPoint::at(5, 9, Point2::new(3.0, 4.0));
+    second.vel_px_per_frame = None; // vy is absent: no velocity
+    assert_eq!(
+        streamed,
+        vec![TrackPoint::at(4, 9, Point2::new(2.25, 3.5)), second]
+    );
+    // An error raised by the consumer stops the reading and comes back as it is.
+    let mut seen = 0;
+    let error = for_each_track_point(&path, TrackFormat::Csv, |_| {
+        seen += 1;
+        Err(sillage_core::Error::input("stop here"))
+    })
+    .unwrap_err();
+    assert_eq!((seen, error.to_string().contains("stop here")), (1, true));
 }
 
 #[test]
