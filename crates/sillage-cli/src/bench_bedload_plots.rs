@@ -7,7 +7,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use sillage::io::{write_png_rgb, write_text};
 use sillage::track::bedload::BedloadTrackerKind;
-use sillage::viz::{Figure, GroupedChart, Series, ValueAxis};
+use sillage::viz::{Figure, GroupedChart, Plot, Series, ValueAxis};
 
 use crate::bench_bedload::{Row, Scope, TABLE_THRESHOLD};
 
@@ -152,10 +152,11 @@ pub fn write_figures(dir: &Path, rows: &[Row]) -> Result<Vec<String>> {
         ("fig6_tau_sweep", fig6(rows)),
         ("fig7_state_f_scores", fig7(rows)),
     ] {
+        let width = PANEL.0 * figure.panels.len() as u32;
         let png = dir.join(format!("{name}.png"));
-        write_png_rgb(&png, &figure.to_rgb(PANEL.0, PANEL.1)?)?;
+        write_png_rgb(&png, &figure.to_rgb(width, PANEL.1)?)?;
         let svg = dir.join(format!("{name}.svg"));
-        write_text(&svg, &figure.to_svg(PANEL.0, PANEL.1)?)?;
+        write_text(&svg, &figure.to_svg(width, PANEL.1)?)?;
         written.extend([png, svg].map(|p| p.display().to_string()));
     }
     Ok(written)

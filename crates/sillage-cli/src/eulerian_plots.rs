@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use sillage::eval::eulerian::{BinStats, EulerianGrid};
 use sillage::io::write_png_rgb;
-use sillage::viz::{HeatCell, Heatmap};
+use sillage::viz::{HeatCell, Heatmap, Plot};
 
 /// The value a heatmap shows for a bin.
 type Field = fn(&BinStats) -> f64;

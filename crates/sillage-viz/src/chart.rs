@@ -4,9 +4,11 @@
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use sillage_core::{Error, Result, RgbImage};
+use sillage_core::{Error, Result};
 
-use crate::font::{FAMILY, ensure_registered};
+use crate::canvas::{Plot, drawing_error};
+use crate::font::FAMILY;
+use crate::legend::{LegendEntry, Mark, draw_legend};
 use crate::palette::series_colour;
 
 /// One named series of a chart: one value per category (`None`: no value there).
@@ -189,96 +191,42 @@ impl GroupedChart {
     /// The legend: one entry per bar series (a box), then per curve without a bar twin (a
     /// line), left to right.
     fn draw_legend<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()> {
-        let font: TextStyle = (FAMILY, 13).into_font().into();
         let curves_only = if self.line_axis.is_some() {
             &self.lines[self.bars.len().min(self.lines.len())..]
         } else {
             &[]
         };
-        let entries = self
-            .bars
-            .iter()
+        let bars = self.bars.iter().map(|s| (s, Mark::Box));
+        let curves = curves_only.iter().map(|s| (s, Mark::Line));
+        let entries: Vec<LegendEntry<'_>> = bars
+            .chain(curves)
             .enumerate()
-            .map(|(i, s)| (i, s, false))
-            .chain(
-                curves_only
-                    .iter()
-                    .enumerate()
-                    .map(|(k, s)| (self.bars.len() + k, s, true)),
-            );
-        let mut x = 60;
-        let y = (LEGEND_HEIGHT / 2) as i32;
-        for (i, series, curve) in entries {
-            let colour = series_colour(i);
-            if curve {
-                area.draw(&PathElement::new(
-                    [(x, y), (x + 14, y)],
-                    colour.stroke_width(2),
-                ))
-                .map_err(drawing_error)?;
-            } else {
-                area.draw(&Rectangle::new(
-                    [(x, y - 6), (x + 14, y + 6)],
-                    colour.filled(),
-                ))
-                .map_err(drawing_error)?;
-            }
-            let text = Text::new(series.label.clone(), (x + 18, y - 5), font.clone());
-            area.draw(&text).map_err(drawing_error)?;
-            let (width, _) = area
-                .estimate_text_size(&series.label, &font)
-                .map_err(drawing_error)?;
-            x += 18 + width as i32 + 16;
-        }
-        Ok(())
+            .map(|(i, (series, mark))| LegendEntry {
+                label: &series.label,
+                colour: series_colour(i),
+                mark,
+            })
+            .collect();
+        draw_legend(area, 60, &entries)
     }
 }
 
-impl Figure {
+impl Plot for Figure {
     /// Checks every panel (see [`GroupedChart::validate`]) and that there is one.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         if self.panels.is_empty() {
             return Err(Error::input("a figure needs at least one chart"));
         }
         self.panels.iter().try_for_each(GroupedChart::validate)
     }
 
-    /// The figure as a picture of `panel_width × height` pixels per panel.
-    pub fn to_rgb(&self, panel_width: u32, height: u32) -> Result<RgbImage> {
-        self.validate()?;
-        ensure_registered()?;
-        let width = panel_width * self.panels.len() as u32;
-        let mut picture = RgbImage::new(width as usize, height as usize);
-        {
-            let backend = BitMapBackend::with_buffer(
-                picture.as_mut_slice().as_flattened_mut(),
-                (width, height),
-            );
-            self.draw_on(backend.into_drawing_area())?;
-        }
-        Ok(picture)
-    }
-
-    /// The figure as an SVG document of `panel_width × height` units per panel.
-    pub fn to_svg(&self, panel_width: u32, height: u32) -> Result<String> {
-        self.validate()?;
-        ensure_registered()?;
-        let width = panel_width * self.panels.len() as u32;
-        let mut svg = String::new();
-        {
-            let backend = SVGBackend::with_string(&mut svg, (width, height));
-            self.draw_on(backend.into_drawing_area())?;
-        }
-        Ok(svg)
-    }
-
-    fn draw_on<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<()> {
-        root.fill(&WHITE).map_err(drawing_error)?;
+    /// The panels side by side, each a same share of the width.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         let areas = root.split_evenly((1, self.panels.len()));
         for (panel, area) in self.panels.iter().zip(&areas) {
             panel.draw(area)?;
         }
-        root.present().map_err(drawing_error)
+        Ok(())
     }
 }
 
@@ -289,11 +237,6 @@ fn tick_label(axis: &ValueAxis, value: f64) -> String {
     } else {
         format!("{value:.1}")
     }
-}
-
-/// A plotters failure as our error (it only fails on backend errors or a missing font).
-pub(crate) fn drawing_error(e: impl std::fmt::Display) -> Error {
-    Error::input(format!("drawing failed: {e}"))
 }
 
 #[cfg(test)]
@@ -326,7 +269,7 @@ mod tests {
         }
     }
 
-    fn count(picture: &RgbImage, colour: RGBColor) -> usize {
+    fn count(picture: &sillage_core::RgbImage, colour: RGBColor) -> usize {
         let want = [colour.0, colour.1, colour.2];
         picture.as_slice().iter().filter(|&&p| p == want).count()
     }
@@ -361,9 +304,9 @@ mod tests {
         let figure = Figure {
             panels: vec![chart(), chart()],
         };
-        let picture = figure.to_rgb(320, 240).unwrap();
+        let picture = figure.to_rgb(640, 240).unwrap();
         assert_eq!(picture.dimensions(), (640, 240));
-        let svg = figure.to_svg(320, 240).unwrap();
+        let svg = figure.to_svg(640, 240).unwrap();
         for text in ["Fig. 6", "MOTA %", "correct tracks %", "MMPF+", "0.25"] {
             assert!(svg.contains(text), "{text} missing");
         }

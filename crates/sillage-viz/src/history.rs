@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use sillage_core::{FrameIndex, TrackPoint};
+use sillage_core::{FrameIndex, TrackPoint, Vec2};
 
 /// Every track's points in frame order.
 #[derive(Debug, Clone, Default)]
@@ -25,6 +25,17 @@ impl TrackHistory {
         }
         tracks.sort_by_key(|t| (t[0].frame, t[0].track_id));
         Self { tracks }
+    }
+
+    /// Keeps only the tracks of at least `min_points` points.
+    pub fn with_min_points(mut self, min_points: usize) -> Self {
+        self.tracks.retain(|t| t.len() >= min_points);
+        self
+    }
+
+    /// Every track's points in frame order, tracks by their first frame.
+    pub fn tracks(&self) -> impl Iterator<Item = &[TrackPoint]> {
+        self.tracks.iter().map(Vec::as_slice)
     }
 
     /// Number of tracks.
@@ -55,6 +66,21 @@ impl TrackHistory {
             Some(&track[begin..end])
         })
     }
+}
+
+/// The velocity of `track[i]` (a track's points in frame order), px/frame: the point's own
+/// when the table has one, else the finite difference of its neighbours' positions over
+/// their frame gap (central inside the track, one-sided at its ends); `None` for a track of
+/// one point or an `i` beyond it.
+pub fn velocity_px_per_frame(track: &[TrackPoint], i: usize) -> Option<Vec2> {
+    let point = track.get(i)?;
+    if let Some(v) = point.vel_px_per_frame.filter(|v| v.is_finite()) {
+        return Some(v);
+    }
+    let before = &track[i.saturating_sub(1)];
+    let after = track.get(i + 1).unwrap_or(point);
+    let frames = after.frame.checked_sub(before.frame).filter(|&n| n > 0)?;
+    Some((after.pos_px - before.pos_px) / frames as f64)
 }
 
 #[cfg(test)]
@@ -91,5 +117,22 @@ mod tests {
         assert_eq!(frames(5, 3), vec![vec![(3, 5)]]);
         assert!(frames(6, 3).is_empty());
         assert!(frames(0, 3).is_empty());
+        assert_eq!(history.with_min_points(2).len(), 1);
+    }
+
+    #[test]
+    fn velocities_are_the_tables_or_finite_differences() {
+        let mut track: Vec<TrackPoint> = [(0, 0.0), (1, 2.0), (3, 10.0)]
+            .map(|(frame, x)| TrackPoint::at(frame, 1, Point2::new(x, 5.0)))
+            .to_vec();
+        let vx = |track: &[TrackPoint], i| velocity_px_per_frame(track, i).map(|v| v.x);
+        // One-sided at the ends, central (over the 3-frame gap) inside.
+        assert_eq!(vx(&track, 0), Some(2.0));
+        assert_eq!(vx(&track, 1), Some(10.0 / 3.0));
+        assert_eq!(vx(&track, 2), Some(4.0));
+        assert_eq!(vx(&track, 3), None);
+        track[1].vel_px_per_frame = Some(Vec2::new(-1.0, 0.0));
+        assert_eq!(vx(&track, 1), Some(-1.0));
+        assert_eq!(vx(&track[..1], 0), None);
     }
 }

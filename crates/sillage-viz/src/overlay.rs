@@ -1,13 +1,14 @@
-//! Overlays: a frame in grey with its detections circled, each track's tail coloured by its
-//! motion state at every step, its head marked and its id written beside it — for looking at
-//! what a tracker did, frame by frame.
+//! Overlays: a frame in grey with its detections circled, each track's tail coloured at every
+//! step by its motion state, its speed or its identity ([`TrackColouring`]), its head marked
+//! and its id written beside it — for looking at what a tracker did, frame by frame.
 
 use plotters::prelude::*;
 use sillage_core::{Detection, Error, GrayImage, Result, RgbImage, TrackPoint};
 
-use crate::chart::drawing_error;
+use crate::canvas::drawing_error;
+use crate::colouring::TrackColouring;
 use crate::font::{FAMILY, ensure_registered};
-use crate::palette::{series_colour, state_colour};
+use crate::palette::series_colour;
 
 /// How overlays are drawn.
 #[derive(Debug, Clone, PartialEq)]
@@ -19,22 +20,26 @@ pub struct OverlayStyle {
     /// Radius of the circle around a detection, px, per detection class (the last radius for
     /// classes beyond the list).
     pub detection_radius_px: Vec<f64>,
+    /// What the tails' colours show.
+    pub colouring: TrackColouring,
 }
 
 impl Default for OverlayStyle {
-    /// Twenty frames of tail, ids shown, 4 px circles.
+    /// Twenty frames of tail coloured by motion state, ids shown, 4 px circles.
     fn default() -> Self {
         Self {
             tail_frames: 20,
             show_ids: true,
             detection_radius_px: vec![4.0],
+            colouring: TrackColouring::State,
         }
     }
 }
 
 impl OverlayStyle {
-    /// Checks the tail length and the radii.
+    /// Checks the tail length, the radii and the colouring.
     pub fn validate(&self) -> Result<()> {
+        self.colouring.validate()?;
         if self.tail_frames == 0 {
             return Err(Error::parameter(
                 "tail_frames",
@@ -91,7 +96,7 @@ pub fn draw_overlay(
             area.draw(&circle).map_err(drawing_error)?;
         }
         for tail in tails {
-            draw_tail(area, frame, tail, style.show_ids)?;
+            draw_tail(area, frame, tail, style)?;
         }
         Ok(())
     })?;
@@ -118,29 +123,31 @@ pub(crate) fn draw_on(
     area.present().map_err(drawing_error)
 }
 
-/// One track's tail (segments coloured by the state at their end), head and id.
+/// One track's tail (segments coloured as their end point), head and id.
 fn draw_tail<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     frame: &GrayImage,
     tail: &[TrackPoint],
-    show_id: bool,
+    style: &OverlayStyle,
 ) -> Result<()> {
     let Some(head) = tail.last() else {
         return Ok(());
     };
-    for pair in tail.windows(2) {
-        let colour = state_colour(pair[1].motion_state);
+    let colour = |i: usize| {
+        let [r, g, b] = style.colouring.point_rgb(tail, i);
+        RGBColor(r, g, b)
+    };
+    for (i, pair) in tail.windows(2).enumerate() {
         let segment = PathElement::new(
             [pixel(pair[0].pos_px), pixel(pair[1].pos_px)],
-            colour.stroke_width(2),
+            colour(i + 1).stroke_width(2),
         );
         area.draw(&segment).map_err(drawing_error)?;
     }
     let (x, y) = pixel(head.pos_px);
-    let colour = state_colour(head.motion_state);
-    area.draw(&Circle::new((x, y), 2, colour.filled()))
+    area.draw(&Circle::new((x, y), 2, colour(tail.len() - 1).filled()))
         .map_err(drawing_error)?;
-    if show_id {
+    if style.show_ids {
         // Dark text on bright backgrounds (backlit beads), bright text on dark ones (PTV).
         let bright = frame_level(frame, x, y) > 0.5;
         let ink = if bright { BLACK } else { WHITE };
@@ -218,6 +225,35 @@ mod tests {
         assert!(ink > 5, "{ink}");
         // Away from the drawing, the frame's grey is kept.
         assert_eq!(picture.get(5, 75), [230, 230, 230]);
+    }
+
+    #[test]
+    fn tails_can_take_the_colour_of_their_id_or_speed() {
+        let frame = GrayImage::from_vec(100, 60, vec![0.0; 100 * 60]).unwrap();
+        let tail: Vec<TrackPoint> = (0..4)
+            .map(|k| TrackPoint::at(k, 3, Point2::new(20.0 + 15.0 * k as f64, 30.0)))
+            .collect();
+        let by = |colouring| {
+            let style = OverlayStyle {
+                colouring,
+                show_ids: false,
+                ..OverlayStyle::default()
+            };
+            draw_overlay(&frame, &[], &[&tail], &style).unwrap()
+        };
+        let by_id = by(TrackColouring::Id);
+        assert!(count(&by_id, crate::palette::id_rgb(3)) > 60);
+        // 15 px/frame on a scale topped at 15: the yellow end of viridis.
+        let fast = by(TrackColouring::Speed {
+            max_px_per_frame: 15.0,
+        });
+        assert!(count(&fast, crate::colormap::viridis(1.0)) > 60);
+        assert_eq!(fast.get(50, 30), crate::colormap::viridis(1.0));
+        let slow = by(TrackColouring::Speed {
+            max_px_per_frame: 150.0,
+        });
+        assert_eq!(count(&slow, crate::colormap::viridis(1.0)), 0);
+        assert_eq!(slow.get(50, 30), crate::colormap::viridis(0.1));
     }
 
     #[test]

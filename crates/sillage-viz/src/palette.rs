@@ -55,30 +55,50 @@ pub fn model_rgb(name: &str, position: usize) -> [u8; 3] {
     }
 }
 
-/// Viridis (matplotlib's perceptually uniform colormap) sampled at nine evenly spaced
-/// points, dark blue to yellow.
-const VIRIDIS: [[u8; 3]; 9] = [
-    [68, 1, 84],
-    [71, 44, 122],
-    [59, 81, 139],
-    [44, 113, 142],
-    [33, 144, 141],
-    [39, 173, 129],
-    [92, 200, 99],
-    [170, 220, 50],
-    [253, 231, 37],
-];
+/// The colour of track `track_id` when tracks are coloured by identity: hues a golden angle
+/// apart (so consecutive ids differ most), strong and mid-bright enough to show on black and
+/// on white.
+pub fn id_rgb(track_id: u64) -> [u8; 3] {
+    const GOLDEN: f64 = 0.618_033_988_749_895;
+    // Wrapping the id keeps the product exact for any u64.
+    let hue = ((track_id % 1_000_003) as f64 * GOLDEN).fract() * 6.0;
+    let (saturation, value) = (0.8, 0.9);
+    let sector = hue.floor();
+    let f = hue - sector;
+    let (p, q, t) = (
+        value * (1.0 - saturation),
+        value * (1.0 - saturation * f),
+        value * (1.0 - saturation * (1.0 - f)),
+    );
+    let (r, g, b) = match sector as u8 {
+        0 => (value, t, p),
+        1 => (q, value, p),
+        2 => (p, value, t),
+        3 => (p, q, value),
+        4 => (t, p, value),
+        _ => (value, p, q),
+    };
+    [r, g, b].map(|c| (c * 255.0).round() as u8)
+}
 
-/// The viridis colour of `t` in [0, 1] (clamped; NaN reads 0), linearly interpolated
-/// between the nine samples: for values on a scale (speeds, densities), readable in grey
-/// and by colour-blind readers.
-pub fn viridis_rgb(t: f64) -> [u8; 3] {
-    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
-    let position = t * (VIRIDIS.len() - 1) as f64;
-    let below = (position.floor() as usize).min(VIRIDIS.len() - 2);
-    let fraction = position - below as f64;
-    let (a, b) = (VIRIDIS[below], VIRIDIS[below + 1]);
-    std::array::from_fn(|k| {
-        (f64::from(a[k]) + (f64::from(b[k]) - f64::from(a[k])) * fraction).round() as u8
-    })
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn neighbouring_ids_take_distinct_hues() {
+        let colours: Vec<[u8; 3]> = (0..8).map(id_rgb).collect();
+        for (i, a) in colours.iter().enumerate() {
+            for b in &colours[i + 1..] {
+                let distance: i32 = a
+                    .iter()
+                    .zip(b)
+                    .map(|(&x, &y)| (i32::from(x) - i32::from(y)).abs())
+                    .sum();
+                assert!(distance > 40, "{a:?} vs {b:?}");
+            }
+        }
+        assert_eq!(id_rgb(0), [230, 46, 46]);
+        assert_eq!(id_rgb(u64::MAX), id_rgb(u64::MAX));
+    }
 }

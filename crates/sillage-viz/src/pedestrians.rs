@@ -12,7 +12,7 @@ use std::collections::{HashMap, VecDeque};
 use plotters::prelude::*;
 use sillage_core::{Error, FrameIndex, Result, RgbImage};
 
-use crate::chart::drawing_error;
+use crate::canvas::drawing_error;
 use crate::font::FAMILY;
 use crate::overlay::{PixelArea, draw_on};
 use crate::palette::model_rgb;
