@@ -14,6 +14,7 @@
 //!   or NumPy `.npy`;
 //! - [`TruthCsvWriter`] / [`read_truth_csv`], [`DetectionsCsvWriter`] /
 //!   [`read_detections_csv`] for ground truth and saved detections;
+//! - [`Mp4Writer`] encodes pictures (overlays) into an MP4 through `ffmpeg`;
 //! - [`read_tractrac_par`] / [`write_tractrac_par`] for TracTrac's `*_par.txt`;
 //! - [`read_mot_sequence`] / [`read_mot_rows`] / [`read_seqinfo`] for MOTChallenge
 //!   `gt.txt`, `det.txt`, results and `seqinfo.ini` (a file or a sequence folder), and
@@ -81,8 +82,8 @@ pub use detections::{
     DETECTIONS_HEADER, DetectionsCsvWriter, read_detections_csv, write_detections_csv,
 };
 pub use frames::{
-    Frame, FrameOptions, FrameSource, open_frames, read_image, write_png_rgb, write_png16,
-    write_text,
+    Frame, FrameOptions, FrameSource, Mp4Writer, open_frames, read_image, write_png_rgb,
+    write_png16, write_text,
 };
 pub use matrix::read_matrix_csv;
 pub use mot::{

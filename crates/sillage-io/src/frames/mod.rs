@@ -6,6 +6,7 @@ mod ccitt;
 mod decode;
 mod encode;
 mod input;
+mod mp4;
 mod tiff_stack;
 mod video;
 
@@ -17,6 +18,7 @@ use sillage_core::{Error, FrameIndex, GrayImage, Result, RgbImage};
 
 pub use decode::read_image;
 pub use encode::{write_png_rgb, write_png16, write_text};
+pub use mp4::Mp4Writer;
 
 use decode::Decoded;
 use input::InputKind;

@@ -21,18 +21,35 @@ pub(crate) struct VideoInfo {
     pub(crate) frames: Option<usize>,
 }
 
-fn missing_program(program: &Path, source: std::io::Error) -> Error {
+/// The error of a failed start of `program` (`ffmpeg`, `ffprobe`): when it is not installed,
+/// what needs it (`purpose`), how to install it and what to do instead (`otherwise`).
+pub(super) fn missing_program(
+    program: &Path,
+    source: std::io::Error,
+    purpose: &str,
+    otherwise: &str,
+) -> Error {
     if source.kind() == std::io::ErrorKind::NotFound {
         Error::MissingProgram {
             program: program.display().to_string(),
-            hint: "videos are read through FFmpeg: install it (`apt-get install ffmpeg` on \
-                   Debian/Ubuntu, `brew install ffmpeg` on macOS), or convert the video to an \
-                   image sequence"
-                .into(),
+            hint: format!(
+                "{purpose} through FFmpeg: install it (`apt-get install ffmpeg` on \
+                 Debian/Ubuntu, `brew install ffmpeg` on macOS), or {otherwise}"
+            ),
         }
     } else {
         Error::io(program, source)
     }
+}
+
+/// [`missing_program`] for reading videos.
+fn missing_reader(program: &Path, source: std::io::Error) -> Error {
+    missing_program(
+        program,
+        source,
+        "videos are read",
+        "convert the video to an image sequence",
+    )
 }
 
 /// Reads the size and frame count of `video` with `ffprobe`.
@@ -44,7 +61,7 @@ pub(crate) fn probe(ffprobe: &Path, video: &Path) -> Result<VideoInfo> {
         .arg(video)
         .stdin(Stdio::null())
         .output()
-        .map_err(|e| missing_program(ffprobe, e))?;
+        .map_err(|e| missing_reader(ffprobe, e))?;
     let bad = |why: String| {
         Error::format(
             video,
@@ -94,7 +111,7 @@ impl FfmpegDecoder {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
-            .map_err(|e| missing_program(ffmpeg, e))?;
+            .map_err(|e| missing_reader(ffmpeg, e))?;
         Ok(Self { child, colour })
     }
 
