@@ -34,7 +34,9 @@ const EXAMPLES: &str = "Examples:
   sillage fit homography PETS09-S2L1/gt/gt.txt --out ground.toml
   sillage detect bead 'flume/*.tif' --sequence-params sequence_param.txt --mask base.png --out det.csv --candidates cand.csv
   sillage track bedload --detections beads/detections.csv --candidates beads/candidates.csv --out beads/tracks.csv
-  sillage eval mot --gt beads/truth.csv --pred beads/tracks.csv --match disc:0.43 --papers";
+  sillage eval mot --gt beads/truth.csv --pred beads/tracks.csv --match disc:0.43 --papers
+  sillage plot trajectories tracks.csv --out trajectories.png --colour speed
+  sillage overlay tracks.csv --frames vortex/ --out overlays/ --mp4 tracks.mp4";
 
 /// The verbs.
 #[derive(Debug, Subcommand)]
@@ -65,6 +67,128 @@ pub enum Command {
     Detect(DetectCommand),
     /// Bin tracks on a grid: mean velocity, Reynolds stresses, TKE, concentration, profiles.
     Eulerian(EulerianArgs),
+    /// Draw a chart of a track table: trajectories, velocity arrows, histograms, counts.
+    Plot(PlotArgs),
+    /// Draw every frame with its detections and track tails, as PNG files and an MP4.
+    Overlay(OverlayArgs),
+}
+
+/// The charts of `sillage plot`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PlotKind {
+    /// Every track as a line on the image plane (`--colour speed|state|id`).
+    Trajectories,
+    /// Velocity arrows at one frame (`--frame`).
+    Quiver,
+    /// Histogram of the displacement per frame (speed, px/frame).
+    Displacements,
+    /// Histogram of log10 of the prediction error (PTV tables).
+    PredictionError,
+    /// Tracks (and, with `--detections`, detections) per frame.
+    Counts,
+}
+
+/// What track colours show (`--colour`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ColourArg {
+    /// Speed, on the viridis map.
+    Speed,
+    /// Motion state (tables with a `motion_state` column).
+    State,
+    /// Track identity.
+    Id,
+}
+
+/// Formats of the track tables `plot` and `overlay` read (`--format`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TableFormatArg {
+    /// TracTrac's `_track.txt`.
+    Tractrac,
+    /// CSV with trackpy column names (`frame,particle,x,y,...`).
+    Csv,
+    /// Apache Parquet.
+    Parquet,
+    /// HDF5.
+    Hdf5,
+    /// BeadTracking's CSV (`frame,id,x,y,category,...`), as `track bedload` writes it.
+    Beads,
+    /// MOTChallenge results (`track immpf`/`siftpf`): box centres.
+    Mot,
+}
+
+/// The track table of `plot` and `overlay`.
+#[derive(Debug, Args)]
+pub struct TracksInputArgs {
+    /// Track table: TracTrac `_track.txt`, CSV, Parquet, HDF5, a bead CSV or MOTChallenge
+    /// results (boxes drawn by their centres).
+    #[arg(value_name = "TRACKS")]
+    pub tracks: PathBuf,
+    /// Format of TRACKS (default: from its extension and first line).
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<TableFormatArg>,
+    /// What track colours show (default: state for tables with motion states, else speed).
+    #[arg(long, value_enum)]
+    pub colour: Option<ColourArg>,
+    /// Detections CSV (`frame,x,y[,class,score]`, as `sillage detect` writes): counted per
+    /// frame, or circled on overlays.
+    #[arg(long, value_name = "FILE")]
+    pub detections: Option<PathBuf>,
+}
+
+/// `sillage plot`.
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    /// Which chart.
+    #[arg(value_enum)]
+    pub kind: PlotKind,
+    /// The tracks.
+    #[command(flatten)]
+    pub input: TracksInputArgs,
+    /// Picture to write: `.png` or `.svg`.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Frame of the velocity arrows (0-based; default: the frame with most tracks).
+    #[arg(long, value_name = "N")]
+    pub frame: Option<u64>,
+    /// Leave out tracks of fewer points.
+    #[arg(long, value_name = "L", default_value_t = 1)]
+    pub min_length: usize,
+    /// Picture size `WxH`, px.
+    #[arg(long, value_name = "WxH", default_value = "800x600")]
+    pub size: FrameSize,
+    /// Histogram bins.
+    #[arg(long, default_value_t = 50)]
+    pub bins: usize,
+    /// Histogram counts on a log scale.
+    #[arg(long)]
+    pub log_y: bool,
+}
+
+/// `sillage overlay`.
+#[derive(Debug, Args)]
+pub struct OverlayArgs {
+    /// The tracks.
+    #[command(flatten)]
+    pub input: TracksInputArgs,
+    /// The frames the tracks were made from (a folder, a quoted glob, a multi-page TIFF or a
+    /// video).
+    #[arg(long, value_name = "FRAMES")]
+    pub frames: String,
+    /// Folder for the pictures, `overlay_NNNNN.png` (0-based frame index).
+    #[arg(long, short, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Also encode the pictures into this MP4 (through the `ffmpeg` program).
+    #[arg(long, value_name = "FILE.mp4")]
+    pub mp4: Option<PathBuf>,
+    /// Frames per second of the MP4.
+    #[arg(long, default_value_t = 10.0)]
+    pub fps: f64,
+    /// Frames of history in each track's tail.
+    #[arg(long, value_name = "FRAMES", default_value_t = 20)]
+    pub tail: u64,
+    /// Circle radius of the detections, px.
+    #[arg(long, value_name = "PX", default_value_t = 4.0)]
+    pub radius: f64,
 }
 
 /// Where the configuration comes from; later sources override earlier ones.

@@ -170,6 +170,7 @@ pub fn run(args: &DemoBedloadArgs) -> Result<()> {
             &kept,
             tracks.clone(),
             &style,
+            None,
         )?;
     }
 

@@ -304,7 +304,7 @@ fn read_objects(path: &Path, with_seqinfo: bool) -> Result<(Objects, Option<u64>
 }
 
 /// The first non-blank line of `path` (empty for an empty file), trimmed.
-fn first_line(path: &Path) -> Result<String> {
+pub(crate) fn first_line(path: &Path) -> Result<String> {
     let file = std::fs::File::open(path).map_err(|e| sillage::core::Error::io(path, e))?;
     let mut reader = std::io::BufReader::new(file);
     let mut line = Vec::new();

@@ -25,6 +25,7 @@ mod fit_pedestrian;
 mod ground_plane;
 mod overlay;
 mod pedestrian_input;
+mod plot;
 mod progress;
 mod ptv;
 mod synth;
@@ -32,6 +33,7 @@ mod synth_bedload;
 mod synth_walkers;
 mod track;
 mod track_immpf;
+mod track_input;
 mod track_siftpf;
 
 use clap::Parser;
@@ -63,6 +65,8 @@ fn main() {
         cli::Command::Track(cli::TrackCommand::Siftpf(a)) => track_siftpf::run(&a),
         cli::Command::Detect(cli::DetectCommand::Bead(a)) => detect::run_bead(&a),
         cli::Command::Eulerian(a) => eulerian::run(&a),
+        cli::Command::Plot(a) => plot::run(&a),
+        cli::Command::Overlay(a) => overlay::run(&a),
     };
     if let Err(error) = outcome {
         eprintln!("error: {error:#}");

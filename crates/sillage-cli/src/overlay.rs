@@ -1,39 +1,100 @@
-//! `--overlay DIR`: one PNG per frame with the frame's detections circled and the track
-//! tails coloured by motion state, with ids (resting blue, rolling orange, saltating
-//! vermillion, unknown grey) — for looking at what a tracker did; and the pedestrian
-//! overlays of `sillage track immpf --overlay DIR` (boxes, model-weight bars, trajectories
-//! coloured by the dominant model).
+//! `sillage overlay` and `--overlay DIR`: one PNG per frame with the frame's detections
+//! circled and the track tails coloured by motion state (resting blue, rolling orange,
+//! saltating vermillion, unknown grey), speed or id, with ids — for looking at what a tracker
+//! did — and, with `--mp4`, the same pictures as a video; and the pedestrian overlays of
+//! `sillage track immpf --overlay DIR` (boxes, model-weight bars, trajectories coloured by the
+//! dominant model).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use sillage::core::{Detection, FrameIndex, TrackPoint};
-use sillage::io::{FrameOptions, open_frames, write_png_rgb};
+use sillage::io::{FrameOptions, Mp4Writer, open_frames, read_detections_csv, write_png_rgb};
 use sillage::track::immpf::{ModelName, PedestrianEstimate};
 use sillage::viz::{
     OverlayStyle, PedestrianTrails, PersonOverlay, TrackHistory, draw_overlay, draw_pedestrians,
 };
 
+use crate::cli::OverlayArgs;
+use crate::plot::colouring;
 use crate::progress::FrameProgress;
+use crate::track_input::read_tracks_for_drawing;
 
 /// The detections of each frame, kept for drawing.
 pub type DetectionsByFrame = BTreeMap<FrameIndex, Vec<Detection>>;
 
+/// An MP4 to encode the overlays into, at `fps` frames per second.
+pub struct VideoOut<'a> {
+    /// The MP4 file.
+    pub path: &'a Path,
+    /// Frames per second.
+    pub fps: f64,
+}
+
+/// `sillage overlay`: the frames with the tracks of a table (and the detections of a CSV).
+pub fn run(args: &OverlayArgs) -> Result<()> {
+    let input = &args.input;
+    let tracks = read_tracks_for_drawing(&input.tracks, input.format)?;
+    let history = TrackHistory::new(tracks.points.iter().copied());
+    let style = OverlayStyle {
+        tail_frames: args.tail,
+        detection_radius_px: vec![args.radius],
+        colouring: colouring(input, tracks.has_states, &history)?,
+        ..OverlayStyle::default()
+    };
+    let detections = match &input.detections {
+        Some(path) => read_detections_csv(path)?.into_iter().collect(),
+        None => DetectionsByFrame::new(),
+    };
+    let video = args.mp4.as_deref().map(|path| VideoOut {
+        path,
+        fps: args.fps,
+    });
+    let n = write_overlays(
+        &args.frames,
+        &args.out,
+        &detections,
+        tracks.points,
+        &style,
+        video,
+    )?;
+    eprintln!("{n} overlays → {}", args.out.display());
+    if let Some(path) = &args.mp4 {
+        eprintln!("video → {}", path.display());
+    }
+    Ok(())
+}
+
 /// Draws every frame of `input` with its `detections` and the tails of `tracks` into `dir`
-/// as `overlay_NNNNN.png` (frame index, 0-based); returns the number of files written.
+/// as `overlay_NNNNN.png` (frame index, 0-based), and into `video` when given; returns the
+/// number of frames drawn.
 pub fn write_overlays(
     input: &str,
     dir: &Path,
     detections: &DetectionsByFrame,
     tracks: Vec<TrackPoint>,
     style: &OverlayStyle,
+    video: Option<VideoOut<'_>>,
 ) -> Result<usize> {
     style.validate()?;
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create the folder {}", dir.display()))?;
     let history = TrackHistory::new(tracks);
     let frames = open_frames(input, &FrameOptions::default())?;
+    let mut encoder = match &video {
+        Some(v) => {
+            let (width, height) = frames.dimensions();
+            Some(Mp4Writer::create(
+                v.path,
+                width,
+                height,
+                v.fps,
+                Path::new("ffmpeg"),
+            )?)
+        }
+        None => None,
+    };
     let mut progress = FrameProgress::new(frames.len(), "drawing overlays");
     let mut written = 0;
     for frame in frames {
@@ -46,10 +107,16 @@ pub fn write_overlays(
             dir.join(format!("overlay_{:05}.png", frame.index)),
             &picture,
         )?;
+        if let Some(encoder) = &mut encoder {
+            encoder.push(&picture)?;
+        }
         written += 1;
         progress.tick();
     }
     progress.finish();
+    if let Some(encoder) = encoder {
+        encoder.finish()?;
+    }
     Ok(written)
 }
 

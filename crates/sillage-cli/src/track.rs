@@ -170,7 +170,7 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
             detection_radius_px: params.radius_px.clone(),
             ..OverlayStyle::default()
         };
-        let n = write_overlays(input, dir, &kept, tracks, &style)?;
+        let n = write_overlays(input, dir, &kept, tracks, &style, None)?;
         eprintln!("{n} overlays → {}", dir.display());
     }
     let stats = tracker.stats();

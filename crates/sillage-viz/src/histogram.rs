@@ -87,7 +87,7 @@ impl Plot for Histogram {
                 "values (log scale)",
             )
         } else {
-            (|c: u64| c as f64, 0.0..most * 1.08, "values")
+            (|c: u64| c as f64, 0.0..most * 1.08, "count")
         };
         let high = bins.low + bins.width * bins.counts.len() as f64;
         let mut chart = ChartBuilder::on(root)

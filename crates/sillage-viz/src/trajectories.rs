@@ -106,38 +106,41 @@ impl TrajectoryPlot {
     }
 }
 
-/// A vertical viridis bar from 0 to `max_px_per_frame` with its speed axis.
-pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
+/// A vertical viridis bar from 0 (bottom) to `max_px_per_frame` (top), with five speed
+/// ticks to its right and the unit above.
+fn draw_colour_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     max_px_per_frame: f64,
 ) -> Result<()> {
-    let mut chart = ChartBuilder::on(area)
-        .margin_top(40)
-        .margin_bottom(50)
-        .margin_right(8)
-        .y_label_area_size(56)
-        .build_cartesian_2d(0.0..1.0, 0.0..max_px_per_frame)
+    const STEPS: i32 = 64;
+    let (_, height) = area.dim_in_pixel();
+    let (top, bottom) = (56, height as i32 - 60);
+    let (left, right) = (12, 30);
+    let font = (FAMILY, 12).into_font();
+    area.draw(&Text::new("px/frame", (left - 6, top - 22), font.clone()))
         .map_err(drawing_error)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_desc("speed (px/frame)")
-        .y_label_formatter(&|v| format!("{v:.2}"))
-        .label_style((FAMILY, 12))
-        .axis_desc_style((FAMILY, 13))
-        .draw()
-        .map_err(drawing_error)?;
-    const STEPS: usize = 64;
-    let step = max_px_per_frame / STEPS as f64;
-    let cells = (0..STEPS).map(|k| {
-        let [r, g, b] = viridis((k as f64 + 0.5) / STEPS as f64);
-        Rectangle::new(
-            [(0.0, k as f64 * step), (1.0, (k + 1) as f64 * step)],
+    let y_at = |t: f64| bottom - (t * f64::from(bottom - top)).round() as i32;
+    for k in 0..STEPS {
+        let [r, g, b] = viridis((f64::from(k) + 0.5) / f64::from(STEPS));
+        let (t0, t1) = (
+            f64::from(k) / f64::from(STEPS),
+            f64::from(k + 1) / f64::from(STEPS),
+        );
+        let cell = Rectangle::new(
+            [(left, y_at(t1)), (right, y_at(t0))],
             RGBColor(r, g, b).filled(),
-        )
-    });
-    chart.draw_series(cells).map_err(drawing_error)?;
+        );
+        area.draw(&cell).map_err(drawing_error)?;
+    }
+    for tick in 0..=4 {
+        let t = f64::from(tick) / 4.0;
+        let y = y_at(t);
+        area.draw(&PathElement::new([(right, y), (right + 4, y)], BLACK))
+            .map_err(drawing_error)?;
+        let label = format!("{:.2}", t * max_px_per_frame);
+        area.draw(&Text::new(label, (right + 7, y - 6), font.clone()))
+            .map_err(drawing_error)?;
+    }
     Ok(())
 }
 
@@ -204,14 +207,14 @@ mod tests {
         let (_, on_line) = rows_of(&picture, viridis(0.5));
         assert!(on_line > 250, "{on_line}");
         // The bar, in the right strip, holds both ends of the map.
-        let bar_has = |rgb| (0..400).any(|y| (430..500).any(|x| picture.get(x, y) == rgb));
+        let bar_has = |rgb| (0..400).any(|y| (416..500).any(|x| picture.get(x, y) == rgb));
         assert!(bar_has(viridis(0.5 / 64.0)) && bar_has(viridis(63.5 / 64.0)));
         let svg = plot(TrackColouring::Speed {
             max_px_per_frame: 20.0,
         })
         .to_svg(500, 400)
         .unwrap();
-        for text in ["tracks", "speed (px/frame)", "x (px)", "<polyline"] {
+        for text in ["tracks", "px/frame", "20.00", "x (px)", "<polyline"] {
             assert!(svg.contains(text), "{text} missing");
         }
     }
