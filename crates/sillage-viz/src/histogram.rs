@@ -84,7 +84,7 @@ impl Plot for Histogram {
             (
                 |c: u64| (c as f64).log10(),
                 0.5f64.log10()..most.log10() + 0.3,
-                "values (log scale)",
+                "count (log scale)",
             )
         } else {
             (|c: u64| c as f64, 0.0..most * 1.08, "count")
@@ -198,7 +198,7 @@ mod tests {
         let log = histogram(values, true).to_rgb(400, 300).unwrap();
         assert!(blue_pixels(&log) < blue_pixels(&picture));
         let svg = histogram(vec![1.0, 2.0], true).to_svg(400, 300).unwrap();
-        assert!(svg.contains("speed (px/frame)") && svg.contains("log scale"));
+        assert!(svg.contains("speed (px/frame)") && svg.contains("count (log scale)"));
     }
 
     #[test]
