@@ -30,17 +30,20 @@ pub fn run(args: &EulerianArgs) -> Result<()> {
     let bins = grid.bins();
     write_numeric_table(&args.out, &stats_table(&bins)?)?;
     let mut written = vec![args.out.clone()];
+    let mut profiles = Vec::new();
     for &axis in &args.profile {
         let path = profile_path(&args.out, axis);
-        let profile = grid.profile(match axis {
+        let axis = match axis {
             AxisArg::X => ProfileAxis::X,
             AxisArg::Y => ProfileAxis::Y,
-        });
+        };
+        let profile = grid.profile(axis);
         write_numeric_table(&path, &stats_table(&profile)?)?;
         written.push(path);
+        profiles.push((axis, profile));
     }
     if let Some(dir) = &args.plots {
-        written.extend(crate::eulerian_plots::write(dir, &grid, &bins)?);
+        written.extend(crate::eulerian_plots::write(dir, &grid, &bins, &profiles)?);
     }
     report(args, &grid, bins.len(), &written);
     Ok(())

@@ -1,13 +1,14 @@
 //! `sillage eulerian --plots DIR`: the per-bin fields as PNG heatmaps (the TracTrac paper's
 //! Fig. 6c: mean speed and turbulent kinetic energy; also the count, both mean velocity
-//! components and the Reynolds shear stress).
+//! components and the Reynolds shear stress), and the profiles as line charts (Fig. 6d: mean
+//! velocity, and the Reynolds stresses, against the position across the flow).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use sillage::eval::eulerian::{BinStats, EulerianGrid};
+use sillage::eval::eulerian::{BinStats, EulerianGrid, ProfileAxis};
 use sillage::io::write_png_rgb;
-use sillage::viz::{HeatCell, Heatmap, Plot};
+use sillage::viz::{Curve, HeatCell, Heatmap, LineChart, Plot};
 
 /// The value a heatmap shows for a bin.
 type Field = fn(&BinStats) -> f64;
@@ -15,8 +16,14 @@ type Field = fn(&BinStats) -> f64;
 /// Picture size of each heatmap, px.
 const SIZE: (u32, u32) = (720, 600);
 
-/// Writes one heatmap per field into `dir`; returns the files written.
-pub fn write(dir: &Path, grid: &EulerianGrid, bins: &[BinStats]) -> Result<Vec<PathBuf>> {
+/// Writes one heatmap per field into `dir`, and two line charts per profile (mean velocity;
+/// Reynolds stresses); returns the files written.
+pub fn write(
+    dir: &Path,
+    grid: &EulerianGrid,
+    bins: &[BinStats],
+    profiles: &[(ProfileAxis, Vec<BinStats>)],
+) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create the folder {}", dir.display()))?;
     let calibrated = grid.params().calibration.is_some();
@@ -60,6 +67,49 @@ pub fn write(dir: &Path, grid: &EulerianGrid, bins: &[BinStats]) -> Result<Vec<P
         let path = dir.join(format!("eulerian_{name}.png"));
         write_png_rgb(&path, &map.to_rgb(SIZE.0, SIZE.1)?)?;
         written.push(path);
+    }
+    for (axis, profile) in profiles {
+        let (name, along): (&str, fn(&BinStats) -> f64) = match axis {
+            ProfileAxis::X => ("x", |b| b.centre.x),
+            ProfileAxis::Y => ("y", |b| b.centre.y),
+        };
+        let curve = |label: &str, value: Field| Curve {
+            label: label.into(),
+            points: profile.iter().map(|b| (along(b), value(b))).collect(),
+        };
+        let charts = [
+            (
+                "velocity",
+                velocity,
+                vec![
+                    curve("<u>", |b| b.mean_velocity.x),
+                    curve("<v>", |b| b.mean_velocity.y),
+                ],
+            ),
+            (
+                "stresses",
+                stress,
+                vec![
+                    curve("<u'u'>", |b| b.stresses[0]),
+                    curve("<v'v'>", |b| b.stresses[1]),
+                    curve("<u'v'>", |b| b.stresses[2]),
+                ],
+            ),
+        ];
+        for (what, unit, curves) in charts {
+            let chart = LineChart {
+                title: format!("profile along {name}: {what}"),
+                x_label: format!("{name} ({length})"),
+                y_label: format!("{what} ({unit})"),
+                curves,
+            };
+            if chart.validate().is_err() {
+                continue; // no velocities: nothing to draw.
+            }
+            let path = dir.join(format!("eulerian_profile_{name}_{what}.png"));
+            write_png_rgb(&path, &chart.to_rgb(SIZE.0, SIZE.1)?)?;
+            written.push(path);
+        }
     }
     Ok(written)
 }

@@ -124,7 +124,18 @@ fn vortex_mean_velocity_matches_the_analytic_field() {
         let all: f64 = bins.iter().map(|b| b["points"]).sum();
         assert_eq!(points, all, "a profile pools every point");
     }
-    for name in ["points", "speed", "u", "v", "tke", "uv"] {
+    for name in [
+        "points",
+        "speed",
+        "u",
+        "v",
+        "tke",
+        "uv",
+        "profile_x_velocity",
+        "profile_x_stresses",
+        "profile_y_velocity",
+        "profile_y_stresses",
+    ] {
         let png = plots.join(format!("eulerian_{name}.png"));
         let picture = image::open(&png).unwrap();
         assert_eq!((picture.width(), picture.height()), (720, 600), "{name}");

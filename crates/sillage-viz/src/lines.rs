@@ -67,22 +67,33 @@ impl Plot for LineChart {
             })
             .collect();
         draw_legend(&legend, 70, &entries)?;
-        let (x_min, x_max, y_max) = self.points().fold(
-            (f64::INFINITY, f64::NEG_INFINITY, 0.0f64),
-            |(a, b, c), (x, y)| (a.min(x), b.max(x), c.max(y)),
+        let (x_min, x_max, y_min, y_max) = self.points().fold(
+            (f64::INFINITY, f64::NEG_INFINITY, 0.0f64, 0.0f64),
+            |(a, b, c, d), (x, y)| (a.min(x), b.max(x), c.min(y), d.max(y)),
         );
         let x_range = if x_min < x_max {
             x_min..x_max
         } else {
             x_min - 0.5..x_min + 0.5
         };
-        let y_top = if y_max > 0.0 { y_max * 1.08 } else { 1.0 };
+        // The y axis always shows 0 (counts from 0; signed profiles such as ⟨u'v'⟩ across it).
+        let y_range = if y_max > y_min {
+            let pad = 0.08 * (y_max - y_min);
+            (if y_min < 0.0 { y_min - pad } else { 0.0 })..(if y_max > 0.0 {
+                y_max + pad
+            } else {
+                0.0
+            })
+        } else {
+            0.0..1.0
+        };
+        let (x_span, y_span) = (x_range.end - x_range.start, y_range.end - y_range.start);
         let mut chart = ChartBuilder::on(&area)
             .caption(&self.title, (FAMILY, 18))
             .margin(10)
             .x_label_area_size(44)
             .y_label_area_size(60)
-            .build_cartesian_2d(x_range, 0.0..y_top)
+            .build_cartesian_2d(x_range, y_range)
             .map_err(drawing_error)?;
         chart
             .configure_mesh()
@@ -90,8 +101,8 @@ impl Plot for LineChart {
             .bold_line_style(RGBColor(230, 230, 230))
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_label_formatter(&|v| format!("{v:.0}"))
+            .x_label_formatter(&|v| tick_label(*v, x_span))
+            .y_label_formatter(&|v| tick_label(*v, y_span))
             .label_style((FAMILY, 12))
             .axis_desc_style((FAMILY, 13))
             .draw()
@@ -108,6 +119,13 @@ impl Plot for LineChart {
         }
         Ok(())
     }
+}
+
+/// A tick value with as many decimals as an axis spanning `span` needs (whole numbers from a
+/// span of 100 up; 0.0012 on a span of 0.01).
+fn tick_label(value: f64, span: f64) -> String {
+    let decimals = (2.0 - span.log10().floor()).clamp(0.0, 9.0) as usize;
+    format!("{value:.decimals$}")
 }
 
 #[cfg(test)]
@@ -180,5 +198,19 @@ mod tests {
                 .to_string()
                 .contains("no point")
         );
+    }
+
+    #[test]
+    fn negative_values_lie_below_a_positive_one_and_ticks_fit_the_span() {
+        let mut chart = chart();
+        chart.curves[0].points = (0..50).map(|f| (f as f64, 1.0)).collect();
+        chart.curves[1].points = (0..50).map(|f| (f as f64, -1.0)).collect();
+        let picture = chart.to_rgb(400, 300).unwrap();
+        let (positive, negative) = (rows(&picture, 0), rows(&picture, 1));
+        assert!(!positive.is_empty() && !negative.is_empty());
+        assert!(negative[0] > positive[0] + 100, "{positive:?} {negative:?}");
+        assert_eq!(tick_label(1200.0, 1000.0), "1200");
+        assert_eq!(tick_label(0.0012, 0.01), "0.0012");
+        assert_eq!(tick_label(2.5, 5.0), "2.50");
     }
 }
