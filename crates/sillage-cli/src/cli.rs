@@ -36,7 +36,9 @@ const EXAMPLES: &str = "Examples:
   sillage track bedload --detections beads/detections.csv --candidates beads/candidates.csv --out beads/tracks.csv
   sillage eval mot --gt beads/truth.csv --pred beads/tracks.csv --match disc:0.43 --papers
   sillage plot trajectories tracks.csv --out trajectories.png --colour speed
-  sillage overlay tracks.csv --frames vortex/ --out overlays/ --mp4 tracks.mp4";
+  sillage overlay tracks.csv --frames vortex/ --out overlays/ --mp4 tracks.mp4
+  sillage eulerian tracks.csv --bin 16 --profile y --out stats.csv --plots maps/
+  sillage view tracks.csv --frames vortex/ --out view.html   # open view.html in a browser";
 
 /// The verbs.
 #[derive(Debug, Subcommand)]
@@ -71,6 +73,8 @@ pub enum Command {
     Plot(PlotArgs),
     /// Draw every frame with its detections and track tails, as PNG files and an MP4.
     Overlay(OverlayArgs),
+    /// Write a self-contained HTML page that plays tracks over their frames.
+    View(ViewArgs),
 }
 
 /// The charts of `sillage plot`.
@@ -1232,4 +1236,26 @@ pub struct DetectBeadArgs {
     /// Print a machine-readable summary on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `sillage view`.
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// Track table (TracTrac _track.txt, CSV, Parquet).
+    pub tracks: PathBuf,
+    /// The frames the tracks were made from: a folder, a quoted glob, a multi-page TIFF or a video.
+    #[arg(long, value_name = "INPUT")]
+    pub frames: String,
+    /// The HTML file to write; the downscaled frames go to the folder <stem>_frames beside it.
+    #[arg(long, short, value_name = "FILE.html")]
+    pub out: PathBuf,
+    /// Longest side of the frames in the page, px (smaller frames are kept as they are).
+    #[arg(long, default_value_t = 1024)]
+    pub max_side: usize,
+    /// Length of the track tails first shown, frames (changeable in the page).
+    #[arg(long, default_value_t = 20)]
+    pub tail: usize,
+    /// Format of the track table (default: from its extension).
+    #[arg(long, value_enum)]
+    pub format: Option<FormatArg>,
 }

@@ -35,6 +35,7 @@ mod track;
 mod track_immpf;
 mod track_input;
 mod track_siftpf;
+mod view;
 
 use clap::Parser;
 
@@ -67,6 +68,7 @@ fn main() {
         cli::Command::Eulerian(a) => eulerian::run(&a),
         cli::Command::Plot(a) => plot::run(&a),
         cli::Command::Overlay(a) => overlay::run(&a),
+        cli::Command::View(a) => view::run(&a),
     };
     if let Err(error) = outcome {
         eprintln!("error: {error:#}");
