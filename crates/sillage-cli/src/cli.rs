@@ -38,7 +38,8 @@ const EXAMPLES: &str = "Examples:
   sillage plot trajectories tracks.csv --out trajectories.png --colour speed
   sillage overlay tracks.csv --frames vortex/ --out overlays/ --mp4 tracks.mp4
   sillage eulerian tracks.csv --bin 16 --profile y --out stats.csv --plots maps/
-  sillage view tracks.csv --frames vortex/ --out view.html   # open view.html in a browser";
+  sillage view tracks.csv --frames vortex/ --out view.html   # open view.html in a browser
+  sillage tune 'run1/*.tif' --save run1.toml     # tune the detector live; then sillage ptv --config run1.toml";
 
 /// The verbs.
 #[derive(Debug, Subcommand)]
@@ -75,6 +76,9 @@ pub enum Command {
     Overlay(OverlayArgs),
     /// Write a self-contained HTML page that plays tracks over their frames.
     View(ViewArgs),
+    /// Tune the detector in a browser: parameters as controls, detections redrawn live, "save"
+    /// writes the config file.
+    Tune(TuneArgs),
 }
 
 /// The charts of `sillage plot`.
@@ -1258,4 +1262,23 @@ pub struct ViewArgs {
     /// Format of the track table (default: from its extension).
     #[arg(long, value_enum)]
     pub format: Option<FormatArg>,
+}
+
+/// `sillage tune`.
+#[derive(Debug, Args)]
+pub struct TuneArgs {
+    /// Frames: a folder, a quoted glob pattern, a multi-page TIFF or a video.
+    pub input: String,
+    /// The configuration the page starts from (as `sillage ptv`'s).
+    #[command(flatten)]
+    pub config: ConfigArgs,
+    /// Where "save" writes the configuration (TOML, for `sillage ptv --config`).
+    #[arg(long, value_name = "FILE", default_value = "sillage.toml")]
+    pub save: PathBuf,
+    /// Frames loaded for tuning: the first N of the sequence, kept in memory.
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    pub max_frames: usize,
+    /// Port on 127.0.0.1 (0: a free one); the address is printed on the first line of stdout.
+    #[arg(long, default_value_t = 0)]
+    pub port: u16,
 }

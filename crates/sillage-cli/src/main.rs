@@ -35,6 +35,8 @@ mod track;
 mod track_immpf;
 mod track_input;
 mod track_siftpf;
+mod tune;
+mod tune_http;
 mod view;
 
 use clap::Parser;
@@ -69,6 +71,7 @@ fn main() {
         cli::Command::Plot(a) => plot::run(&a),
         cli::Command::Overlay(a) => overlay::run(&a),
         cli::Command::View(a) => view::run(&a),
+        cli::Command::Tune(a) => tune::run(&a),
     };
     if let Err(error) = outcome {
         eprintln!("error: {error:#}");

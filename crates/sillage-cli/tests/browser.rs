@@ -1,4 +1,4 @@
-//! Browser tests of `sillage view` in headless Chromium, driven over
+//! Browser tests of `sillage view` and `sillage tune` in headless Chromium, driven over
 //! WebDriver (`tests/webdriver`). They need Debian's `chromium` and `chromium-driver`, so they
 //! are ignored by default and run by `.ci/run`:
 //! `cargo test -p sillage-cli --test browser -- --ignored`.
@@ -8,15 +8,32 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 mod common;
+mod http_client;
+mod tune_server;
 mod webdriver;
 use common::{path_str, run_ok};
+use http_client::{http, wait_until};
+use tune_server::TuneServer;
 use webdriver::Browser;
 
 use sillage::core::{FrameIndex, TrackId, TrackPoint};
+use sillage::detect::blob::Threshold;
 use sillage::io::{TrackFormat, read_track_table};
+use sillage::{DetectorConfig, PipelineConfig};
 
 /// A small vortex sequence in `dir/frames`, tracked into `dir/tracks.csv`.
 fn tracked_vortex(dir: &Path, frames: usize) {
+    let frames_dir = vortex_frames(dir, frames);
+    run_ok(&[
+        "ptv",
+        path_str(&frames_dir),
+        "--out",
+        path_str(&dir.join("tracks.csv")),
+    ]);
+}
+
+/// A small vortex sequence (256×192, 40 particles) in `dir/frames`.
+fn vortex_frames(dir: &Path, frames: usize) -> std::path::PathBuf {
     let frames_dir = dir.join("frames");
     let n = frames.to_string();
     run_ok(&[
@@ -37,12 +54,7 @@ fn tracked_vortex(dir: &Path, frames: usize) {
         "--delta",
         "0.05",
     ]);
-    run_ok(&[
-        "ptv",
-        path_str(&frames_dir),
-        "--out",
-        path_str(&dir.join("tracks.csv")),
-    ]);
+    frames_dir
 }
 
 /// Keeps `picture` under `$SILLAGE_SCREENSHOTS/name` when that variable is set.
@@ -201,4 +213,109 @@ fn viewer_plays_hovers_and_filters() {
     ));
     assert_eq!(browser.eval("return sillageViewer.shown()"), inside);
     assert!(inside >= 1 && inside < now.len());
+}
+
+/// The number the page shows as its detection count.
+fn shown_count(browser: &Browser) -> usize {
+    let text = browser.text(&browser.find("#count"));
+    text.parse()
+        .unwrap_or_else(|_| panic!("count {text:?} is not a number"))
+}
+
+/// Clicks the threshold slider at `fraction` of its width and waits for the new detections.
+fn click_threshold(browser: &Browser, fraction: f64) -> f64 {
+    let done = browser.eval("return window.sillageTune.completed");
+    let [x, y, w, h] = browser.rect(&browser.find("#threshold"));
+    browser.click_at(
+        (x + fraction * w).round() as i64,
+        (y + h / 2.0).round() as i64,
+    );
+    browser.wait_for(&format!(
+        "return window.sillageTune.completed > {done} && !window.sillageTune.busy"
+    ));
+    browser
+        .eval("return Number(document.getElementById('threshold').value)")
+        .as_f64()
+        .expect("a slider value")
+}
+
+#[test]
+#[ignore = "needs chromium and chromedriver; run by .ci/run"]
+fn tune_threshold_slider_changes_the_count_and_save_writes_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = vortex_frames(dir.path(), 3);
+    let saved = dir.path().join("tuned.toml");
+    let server = TuneServer::start(&[
+        path_str(&frames),
+        "--max-frames",
+        "3",
+        "--save",
+        path_str(&saved),
+    ]);
+    let browser = Browser::start(1100, 800);
+    browser.goto(&server.url());
+    browser.wait_for("return window.sillageTune.completed >= 1 && !window.sillageTune.busy");
+    let initial = shown_count(&browser);
+    assert!(
+        (30..=45).contains(&initial),
+        "{initial} detections of 40 particles"
+    );
+
+    // Near the left end, k ≈ 0: noise maxima come through.
+    let k_low = click_threshold(&browser, 0.03);
+    assert!(k_low < 1.0, "k = {k_low}");
+    let low = shown_count(&browser);
+    assert!(
+        low > 2 * initial,
+        "k = {k_low}: {low} detections, {initial} at k = 4"
+    );
+    // Near the right end only the brightest particles remain.
+    let k_high = click_threshold(&browser, 0.97);
+    assert!(k_high > 45.0, "k = {k_high}");
+    let high = shown_count(&browser);
+    assert!(
+        high < initial,
+        "k = {k_high}: {high} detections, {initial} at k = 4"
+    );
+
+    // The page shows what the server computes for the same parameters.
+    let config = browser.eval("return config");
+    let (status, reply) = http(
+        server.port,
+        "POST",
+        "/api/detect",
+        Some(&serde_json::json!({"frame": 0, "config": config})),
+    );
+    assert_eq!(status, 200);
+    let reply: serde_json::Value = serde_json::from_slice(&reply).unwrap();
+    assert_eq!(reply["count"].as_u64(), Some(high as u64));
+
+    // The detections are drawn: cyan circles on the grey frame.
+    let picture = browser.screenshot();
+    keep_screenshot(&picture, "tune.png");
+    let [cx, cy, cw, ch] = browser.rect(&browser.find("#view"));
+    let canvas_box = [cx as u32, cy as u32, (cx + cw) as u32, (cy + ch) as u32];
+    let cyan = count_pixels(&picture, canvas_box, |[r, g, b, _]| {
+        r < 80 && g > 170 && b > 200
+    });
+    assert!(
+        cyan >= 20 * high,
+        "{cyan} cyan pixels for {high} detections"
+    );
+
+    browser.click(&browser.find("#save"));
+    wait_until(
+        "the saved configuration",
+        std::time::Duration::from_secs(15),
+        || saved.exists(),
+    );
+    browser.wait_for("return document.getElementById('saved').textContent.startsWith('saved to')");
+    let written = PipelineConfig::from_toml_file(&saved).unwrap();
+    let DetectorConfig::Blob(params) = written.detector;
+    match params.threshold {
+        Threshold::Noise { k } => {
+            assert!((k - k_high).abs() < 1e-9, "saved k = {k}, slider {k_high}")
+        }
+        other => panic!("saved threshold {other:?}"),
+    }
 }

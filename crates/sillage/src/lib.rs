@@ -19,11 +19,13 @@
 
 pub mod bedload;
 pub mod config;
+pub mod detection_stage;
 pub mod pipeline;
 pub mod toml_config;
 pub mod tractrac;
 
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
+pub use detection_stage::DetectionStage;
 pub use pipeline::{FrameReport, Pipeline, RunSummary};
 
 pub use sillage_assoc as assoc;

@@ -3,28 +3,13 @@
 use std::time::{Duration, Instant};
 
 use sillage_core::{
-    Detection, Detector, DiscardSink, Error, FrameIndex, FrameObservations, GrayImage, Result,
-    TrackPoint, TrackSink, Tracker,
+    Detection, DiscardSink, FrameIndex, FrameObservations, Result, TrackPoint, TrackSink, Tracker,
 };
-use sillage_detect::blob::BlobDetector;
-use sillage_detect::preprocess::Preprocessor;
 use sillage_io::Frame;
 use sillage_track::ptv::{PassDirection, PtvTracker};
 
-use crate::config::{DetectorConfig, PipelineConfig, TrackerConfig};
-
-/// The built-in detectors, chosen by [`DetectorConfig`].
-enum AnyDetector {
-    Blob(BlobDetector),
-}
-
-impl AnyDetector {
-    fn detect(&mut self, image: &GrayImage, out: &mut Vec<Detection>) -> Result<()> {
-        match self {
-            AnyDetector::Blob(d) => d.detect(image, out),
-        }
-    }
-}
+use crate::config::{PipelineConfig, TrackerConfig};
+use crate::detection_stage::DetectionStage;
 
 /// The built-in trackers, chosen by [`TrackerConfig`].
 enum AnyTracker {
@@ -79,14 +64,9 @@ pub struct RunSummary {
 
 /// A configured detector and tracker, fed one frame at a time.
 pub struct Pipeline {
-    preprocessor: Preprocessor,
-    mask: Option<GrayImage>,
-    detector: AnyDetector,
+    stage: DetectionStage,
     tracker: AnyTracker,
     training_passes: usize,
-    /// Whether any pre-processing (median, background, mask) runs before detection.
-    preprocessing: bool,
-    preprocessed: GrayImage,
     detections: Vec<Detection>,
 }
 
@@ -116,27 +96,13 @@ impl Pipeline {
     /// Builds the pipeline of `config` (validated here; the mask image is read here).
     pub fn from_config(config: &PipelineConfig) -> Result<Self> {
         config.validate()?;
-        let mask = config
-            .mask
-            .as_deref()
-            .map(sillage_io::read_image)
-            .transpose()?;
-        let detector = match &config.detector {
-            DetectorConfig::Blob(params) => AnyDetector::Blob(BlobDetector::new(*params)?),
-        };
         let tracker = match &config.tracker {
             TrackerConfig::Ptv(params) => AnyTracker::Ptv(PtvTracker::new(params.clone())?),
         };
         Ok(Self {
-            preprocessor: Preprocessor::new(config.preprocess)?,
-            mask,
-            detector,
+            stage: DetectionStage::from_config(config)?,
             tracker,
             training_passes: config.training_passes,
-            preprocessing: config.preprocess.median.is_some()
-                || config.preprocess.background.is_some()
-                || config.mask.is_some(),
-            preprocessed: GrayImage::default(),
             detections: Vec::new(),
         })
     }
@@ -144,10 +110,7 @@ impl Pipeline {
     /// How many leading frames [`Pipeline::prime_background`] wants (0 without background
     /// subtraction).
     pub fn background_init_frames(&self) -> usize {
-        self.preprocessor
-            .params()
-            .background
-            .map_or(0, |background| background.init_frames)
+        self.stage.background_init_frames()
     }
 
     /// Initialises the background model from the mean of the first frames, as TracTrac does
@@ -162,7 +125,7 @@ impl Pipeline {
         let mut used = 0;
         for frame in frames.take(self.background_init_frames()) {
             let frame = frame?;
-            used += self.preprocessor.prime(std::iter::once(&frame.image))?;
+            used += self.stage.prime_background(std::iter::once(&frame.image))?;
         }
         Ok(used)
     }
@@ -170,30 +133,7 @@ impl Pipeline {
     /// Pre-processes and detects one frame; the detections stay in `self.detections`.
     fn detect(&mut self, frame: &Frame) -> Result<Duration> {
         let start = Instant::now();
-        if let Some(mask) = &self.mask
-            && mask.dimensions() != frame.image.dimensions()
-        {
-            return Err(Error::frame(
-                &frame.path,
-                frame.index,
-                format!(
-                    "the mask is {}×{} but the frame is {}×{}; use a mask of the frame's size",
-                    mask.width(),
-                    mask.height(),
-                    frame.image.width(),
-                    frame.image.height()
-                ),
-            ));
-        }
-        if self.preprocessing {
-            self.preprocessor
-                .process(&frame.image, self.mask.as_ref(), &mut self.preprocessed)?;
-            self.detector
-                .detect(&self.preprocessed, &mut self.detections)?;
-        } else {
-            // Nothing to do before detection: no copy of the frame.
-            self.detector.detect(&frame.image, &mut self.detections)?;
-        }
+        self.stage.detect(frame, &mut self.detections)?;
         Ok(start.elapsed())
     }
 
@@ -259,11 +199,7 @@ impl Pipeline {
     ) -> Result<FrameReport> {
         let before = sink.points;
         let start = Instant::now();
-        let image = match frame {
-            Some(_) if self.preprocessing => Some(&self.preprocessed),
-            Some(frame) => Some(&frame.image),
-            None => None,
-        };
+        let image = frame.map(|frame| self.stage.detector_input(frame));
         let observations = FrameObservations {
             frame: index,
             detections: &self.detections,

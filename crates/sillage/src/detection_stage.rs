@@ -1,0 +1,121 @@
+//! Pre-processing and detection of one frame, as every run does them: `F = median(I)·mask − B`
+//! (TracTrac §3.1.1, Eqs. (1)–(2)), then the configured detector. [`crate::Pipeline`] runs it
+//! before its tracker; the live tuner (`sillage tune`) runs it alone, so what it shows is what
+//! a tracking run sees.
+
+use sillage_core::{Detection, Detector, Error, GrayImage, Result};
+use sillage_detect::blob::BlobDetector;
+use sillage_detect::preprocess::Preprocessor;
+use sillage_io::Frame;
+
+use crate::config::{DetectorConfig, PipelineConfig};
+
+/// The built-in detectors, chosen by [`DetectorConfig`].
+#[derive(Debug, Clone)]
+enum AnyDetector {
+    Blob(BlobDetector),
+}
+
+/// The pre-processor, mask and detector of a [`PipelineConfig`], fed one frame at a time.
+#[derive(Debug, Clone)]
+pub struct DetectionStage {
+    preprocessor: Preprocessor,
+    mask: Option<GrayImage>,
+    detector: AnyDetector,
+    /// Whether any pre-processing (median, background, mask) runs before detection.
+    preprocessing: bool,
+    preprocessed: GrayImage,
+}
+
+impl DetectionStage {
+    /// The stage of `config`'s `preprocess`, `mask` and `detector` sections; their parameters
+    /// are validated and the mask image is read here.
+    pub fn from_config(config: &PipelineConfig) -> Result<Self> {
+        let mask = config
+            .mask
+            .as_deref()
+            .map(sillage_io::read_image)
+            .transpose()?;
+        let detector = match &config.detector {
+            DetectorConfig::Blob(params) => AnyDetector::Blob(BlobDetector::new(*params)?),
+        };
+        Ok(Self {
+            preprocessor: Preprocessor::new(config.preprocess)?,
+            preprocessing: config.preprocess.median.is_some()
+                || config.preprocess.background.is_some()
+                || mask.is_some(),
+            mask,
+            detector,
+            preprocessed: GrayImage::default(),
+        })
+    }
+
+    /// How many leading frames [`DetectionStage::prime_background`] wants (0 without
+    /// background subtraction).
+    pub fn background_init_frames(&self) -> usize {
+        self.preprocessor
+            .params()
+            .background
+            .map_or(0, |background| background.init_frames)
+    }
+
+    /// Initialises the background model from the mean of the first frames (Eq. (2)); at most
+    /// [`DetectionStage::background_init_frames`] are used. Returns how many were.
+    pub fn prime_background<'a>(
+        &mut self,
+        frames: impl IntoIterator<Item = &'a GrayImage>,
+    ) -> Result<usize> {
+        self.preprocessor.prime(frames)
+    }
+
+    /// Pre-processes and detects `frame` into `out`. Errors name the frame and its file when
+    /// the mask's size differs from the frame's.
+    pub fn detect(&mut self, frame: &Frame, out: &mut Vec<Detection>) -> Result<()> {
+        if let Some(mask) = &self.mask
+            && mask.dimensions() != frame.image.dimensions()
+        {
+            return Err(Error::frame(
+                &frame.path,
+                frame.index,
+                format!(
+                    "the mask is {}×{} but the frame is {}×{}; use a mask of the frame's size",
+                    mask.width(),
+                    mask.height(),
+                    frame.image.width(),
+                    frame.image.height()
+                ),
+            ));
+        }
+        let AnyDetector::Blob(detector) = &mut self.detector;
+        if self.preprocessing {
+            self.preprocessor
+                .process(&frame.image, self.mask.as_ref(), &mut self.preprocessed)?;
+            detector.detect(&self.preprocessed, out)
+        } else {
+            // Nothing to do before detection: no copy of the frame.
+            detector.detect(&frame.image, out)
+        }
+    }
+
+    /// The image the detector saw for `frame` (its pre-processed copy, or the frame itself
+    /// when nothing runs before detection); valid after [`DetectionStage::detect`] of `frame`.
+    pub fn detector_input<'a>(&'a self, frame: &'a Frame) -> &'a GrayImage {
+        if self.preprocessing {
+            &self.preprocessed
+        } else {
+            &frame.image
+        }
+    }
+
+    /// The band-passed image of the last frame (the detector's ROI), for threshold displays.
+    pub fn filtered(&self) -> &GrayImage {
+        let AnyDetector::Blob(detector) = &self.detector;
+        detector.filtered()
+    }
+
+    /// The intensity threshold applied to [`DetectionStage::filtered`] on the last frame.
+    pub fn last_threshold(&self) -> Option<f32> {
+        let AnyDetector::Blob(detector) = &self.detector;
+        detector.last_threshold()
+    }
+}
