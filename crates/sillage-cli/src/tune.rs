@@ -4,7 +4,8 @@
 //! the pre-processing and detector parameters as controls. Each change posts the whole
 //! configuration back, and the frame's detections, their count, the threshold and a histogram
 //! of the band-passed image's local maxima are computed by the same [`DetectionStage`] a
-//! tracking run uses, so what the page shows is what `sillage ptv` will see. "Save" writes the
+//! tracking run uses, so what the page shows is what `sillage ptv` will see; the band-passed
+//! image the threshold applies to can be shown instead of the frame. "Save" writes the
 //! configuration as TOML for `sillage ptv --config`.
 
 use std::net::TcpListener;
@@ -15,7 +16,8 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use sillage::core::{Detection, GrayImage};
-use sillage::image::{Peak, PeakFinder};
+use sillage::detect::blob::BlobParams;
+use sillage::image::{Peak, PeakFinder, Roi};
 use sillage::io::{Frame, FrameOptions, open_frames, write_text};
 use sillage::{DetectionStage, PipelineConfig};
 
@@ -162,11 +164,13 @@ impl TuneSession {
             ("POST", "/api/detect") => parse_json(&request.body)
                 .and_then(|r: DetectRequest| self.detect(r.frame, r.config))
                 .map(|reply| Response::json(&reply)),
+            ("POST", "/api/band-passed") => parse_json(&request.body)
+                .and_then(|r: DetectRequest| self.band_passed_png(r.frame, r.config)),
             ("POST", "/api/save") => parse_json(&request.body)
                 .and_then(|r: SaveRequest| self.save(r.config))
                 .map(|path| Response::json(&serde_json::json!({ "path": path }))),
             ("GET", path) if path.starts_with("/frame/") => self.frame_png(path),
-            (_, "/" | "/api/state" | "/api/detect" | "/api/save") => {
+            (_, "/" | "/api/state" | "/api/detect" | "/api/band-passed" | "/api/save") => {
                 return Response::error(405, format!("{} is not allowed here", request.method));
             }
             _ => return Response::error(404, format!("no page at {}", request.path)),
@@ -191,17 +195,27 @@ impl TuneSession {
         }
     }
 
-    /// Runs pre-processing and detection of `config` on frame `index`.
-    fn detect(&self, index: usize, config: serde_json::Value) -> Result<DetectReply> {
+    /// The stage of `config`, primed and run on frame `index`, with its detections and the
+    /// time detection took, ms.
+    fn run_stage(
+        &self,
+        index: usize,
+        config: &PipelineConfig,
+    ) -> Result<(DetectionStage, Vec<Detection>, f64)> {
         let frame = self.frame(index)?;
-        let config = parse_config(config)?;
-        let mut stage = DetectionStage::from_config(&config)?;
+        let mut stage = DetectionStage::from_config(config)?;
         let init = stage.background_init_frames().min(self.frames.len());
         stage.prime_background(self.frames[..init].iter().map(|f| &f.image))?;
         let mut detections: Vec<Detection> = Vec::new();
         let start = Instant::now();
         stage.detect(frame, &mut detections)?;
-        let detect_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok((stage, detections, start.elapsed().as_secs_f64() * 1e3))
+    }
+
+    /// Runs pre-processing and detection of `config` on frame `index`.
+    fn detect(&self, index: usize, config: serde_json::Value) -> Result<DetectReply> {
+        let config = parse_config(config)?;
+        let (stage, detections, detect_ms) = self.run_stage(index, &config)?;
         let threshold = stage.last_threshold();
         Ok(DetectReply {
             frame: index,
@@ -211,9 +225,23 @@ impl TuneSession {
                 .iter()
                 .map(|d| [round_centi(d.pos_px.x), round_centi(d.pos_px.y), d.strength])
                 .collect(),
-            histogram: maxima_histogram(stage.filtered(), config_neighbourhood(&config), threshold),
+            histogram: maxima_histogram(
+                stage.filtered(),
+                blob_params(&config).neighbourhood,
+                threshold,
+            ),
             detect_ms,
         })
+    }
+
+    /// The band-passed image of frame `index` under `config`, frame-sized (outside the ROI at
+    /// its minimum), as a PNG stretched to its range: what the threshold is applied to.
+    fn band_passed_png(&self, index: usize, config: serde_json::Value) -> Result<Response> {
+        let config = parse_config(config)?;
+        let (stage, _, _) = self.run_stage(index, &config)?;
+        let (width, height) = self.frames[index].image.dimensions();
+        let placed = place_in_frame(stage.filtered(), blob_params(&config).roi, width, height);
+        Ok(Response::bytes("image/png", encode_png(&placed)?))
     }
 
     /// Validates `config` and writes it as TOML to the save path (through a temporary file).
@@ -258,10 +286,39 @@ fn parse_config(value: serde_json::Value) -> Result<PipelineConfig> {
     Ok(config)
 }
 
-/// The local-maximum half-window of `config`'s detector.
-fn config_neighbourhood(config: &PipelineConfig) -> usize {
+/// The blob detector's parameters of `config`.
+fn blob_params(config: &PipelineConfig) -> &BlobParams {
     let sillage::DetectorConfig::Blob(params) = &config.detector;
-    params.neighbourhood
+    params
+}
+
+/// `filtered`, the band-passed image of `roi` (the whole frame when `None`), placed in a
+/// `width × height` image whose pixels outside the ROI take its minimum value.
+fn place_in_frame(
+    filtered: &GrayImage,
+    roi: Option<Roi>,
+    width: usize,
+    height: usize,
+) -> GrayImage {
+    let Some(roi) = roi else {
+        return filtered.clone();
+    };
+    let floor = filtered
+        .as_slice()
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(f32::INFINITY, f32::min);
+    let floor = if floor.is_finite() { floor } else { 0.0 };
+    let mut placed = GrayImage::from_vec(width, height, vec![floor; width * height])
+        .expect("the buffer has the frame's size");
+    let (w, h) = filtered.dimensions();
+    for y in 0..h.min(height.saturating_sub(roi.y0)) {
+        let columns = w.min(width.saturating_sub(roi.x0));
+        placed.row_mut(roi.y0 + y)[roi.x0..roi.x0 + columns]
+            .copy_from_slice(&filtered.row(y)[..columns]);
+    }
+    placed
 }
 
 /// Histogram of the values of every local maximum (window `2n+1`) of `filtered`, over the

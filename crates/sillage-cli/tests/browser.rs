@@ -303,6 +303,12 @@ fn tune_threshold_slider_changes_the_count_and_save_writes_it() {
         "{cyan} cyan pixels for {high} detections"
     );
 
+    // The band-passed image can replace the frame.
+    browser.eval(
+        "const e = document.getElementById('show'); e.value = 'band'; e.dispatchEvent(new Event('input'))",
+    );
+    browser.wait_for("return bandImage !== null && bandImage.naturalWidth === 256");
+
     browser.click(&browser.find("#save"));
     wait_until(
         "the saved configuration",

@@ -196,6 +196,20 @@ fn api_names_what_is_wrong() {
     assert_eq!(status, 200);
     let picture = image::load_from_memory(&png).unwrap();
     assert_eq!((picture.width(), picture.height()), (256, 192));
+    // The band-passed image is frame-sized, also with a region of interest.
+    let mut roi = config.clone();
+    roi["detector"]["roi"] = json!({"x0": 32, "y0": 16, "x1": 160, "y1": 112});
+    for body in [
+        json!({"frame": 1, "config": config}),
+        json!({"frame": 1, "config": roi}),
+    ] {
+        let (status, png) = http(server.port, "POST", "/api/band-passed", Some(&body));
+        assert_eq!(status, 200, "{}", String::from_utf8_lossy(&png));
+        let picture = image::load_from_memory(&png).unwrap().to_luma8();
+        assert_eq!(picture.dimensions(), (256, 192));
+        // Particles are bright peaks of the band-passed image: its top is near white.
+        assert!(picture.pixels().any(|p| p.0[0] > 200));
+    }
     let (status, page) = http(server.port, "GET", "/", None);
     assert_eq!(status, 200);
     assert!(String::from_utf8_lossy(&page).contains("<title>sillage tune</title>"));
