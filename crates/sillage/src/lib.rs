@@ -26,7 +26,7 @@ pub mod tractrac;
 
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
 pub use detection_stage::DetectionStage;
-pub use pipeline::{FrameReport, Pipeline, RunSummary};
+pub use pipeline::{FrameInput, FrameReport, Pipeline, RunSummary};
 
 pub use sillage_assoc as assoc;
 pub use sillage_core as core;

@@ -3,7 +3,8 @@
 use std::time::{Duration, Instant};
 
 use sillage_core::{
-    Detection, DiscardSink, FrameIndex, FrameObservations, Result, TrackPoint, TrackSink, Tracker,
+    Detection, DiscardSink, Error, FrameIndex, FrameObservations, Result, TrackPoint, TrackSink,
+    Tracker,
 };
 use sillage_io::Frame;
 use sillage_track::ptv::{PassDirection, PtvTracker};
@@ -26,6 +27,31 @@ impl AnyTracker {
     fn start_pass(&mut self, direction: PassDirection) {
         match self {
             AnyTracker::Ptv(t) => t.start_pass(direction),
+        }
+    }
+}
+
+/// One frame given to [`Pipeline::step`]: an image to detect in, or detections made
+/// elsewhere.
+#[derive(Debug, Clone)]
+pub enum FrameInput {
+    /// A decoded frame: pre-processed, detected, and shown to the tracker.
+    Image(Frame),
+    /// The detections of one frame (a detections table): tracked as they are.
+    Detections {
+        /// The frame's index.
+        frame: FrameIndex,
+        /// Its detections.
+        detections: Vec<Detection>,
+    },
+}
+
+impl FrameInput {
+    /// The frame's index.
+    pub fn index(&self) -> FrameIndex {
+        match self {
+            FrameInput::Image(frame) => frame.index,
+            FrameInput::Detections { frame, .. } => *frame,
         }
     }
 }
@@ -76,6 +102,17 @@ struct CountingSink<'a> {
     points: u64,
     max_track_id: Option<u64>,
     track_ids_seen: u64,
+}
+
+impl<'a> CountingSink<'a> {
+    fn new(inner: &'a mut dyn TrackSink) -> Self {
+        Self {
+            inner,
+            points: 0,
+            max_track_id: None,
+            track_ids_seen: 0,
+        }
+    }
 }
 
 impl TrackSink for CountingSink<'_> {
@@ -137,6 +174,25 @@ impl Pipeline {
         Ok(start.elapsed())
     }
 
+    /// Pre-processes and detects one frame without tracking it (`sillage detect`, Python's
+    /// `locate`): the detections, valid until the next call. Background subtraction, when
+    /// configured, learns from the frames in the order they are given.
+    pub fn locate(&mut self, frame: &Frame) -> Result<&[Detection]> {
+        self.detect(frame)?;
+        Ok(&self.detections)
+    }
+
+    /// Fills `self.detections` from `input`: detected in its image, or copied from it.
+    fn observe(&mut self, input: &FrameInput) -> Result<Duration> {
+        match input {
+            FrameInput::Image(frame) => self.detect(frame),
+            FrameInput::Detections { detections, .. } => {
+                self.detections.clone_from(detections);
+                Ok(Duration::ZERO)
+            }
+        }
+    }
+
     /// Runs the whole sequence: training passes first if configured, then the output pass that
     /// feeds `sink`. `on_frame` is called after every frame of the output pass (progress bars).
     pub fn run(
@@ -145,37 +201,52 @@ impl Pipeline {
         sink: &mut dyn TrackSink,
         on_frame: &mut dyn FnMut(&FrameReport),
     ) -> Result<RunSummary> {
-        let mut counting = CountingSink {
-            inner: sink,
-            points: 0,
-            max_track_id: None,
-            track_ids_seen: 0,
-        };
+        self.run_inputs(frames.map(|f| f.map(FrameInput::Image)), sink, on_frame)
+    }
+
+    /// [`Pipeline::run`] on detections made elsewhere (a detections table): the configured
+    /// detector and pre-processing are skipped, the tracker sees no image. Frames are tracked
+    /// in the order given; leave an empty frame where a frame has no detection, or the tracker
+    /// links across the gap.
+    pub fn run_detections(
+        &mut self,
+        frames: impl Iterator<Item = Result<(FrameIndex, Vec<Detection>)>>,
+        sink: &mut dyn TrackSink,
+        on_frame: &mut dyn FnMut(&FrameReport),
+    ) -> Result<RunSummary> {
+        let inputs = frames
+            .map(|f| f.map(|(frame, detections)| FrameInput::Detections { frame, detections }));
+        self.run_inputs(inputs, sink, on_frame)
+    }
+
+    /// The shared body of [`Pipeline::run`] and [`Pipeline::run_detections`].
+    fn run_inputs(
+        &mut self,
+        inputs: impl Iterator<Item = Result<FrameInput>>,
+        sink: &mut dyn TrackSink,
+        on_frame: &mut dyn FnMut(&FrameReport),
+    ) -> Result<RunSummary> {
+        let mut counting = CountingSink::new(sink);
         let mut totals = RunSummary::default();
         let (mut detect_time, mut track_time) = (Duration::ZERO, Duration::ZERO);
+        let mut add = |report: &FrameReport| {
+            detect_time += report.detect_time;
+            track_time += report.track_time;
+            totals.frames += 1;
+            totals.detections += report.detections as u64;
+            on_frame(report);
+        };
         if self.training_passes == 0 {
-            for frame in frames {
-                let frame = frame?;
-                let detect = self.detect(&frame)?;
-                let report = self.track(frame.index, Some(&frame), detect, &mut counting)?;
-                detect_time += report.detect_time;
-                track_time += report.track_time;
-                totals.frames += 1;
-                totals.detections += report.detections as u64;
-                on_frame(&report);
+            for input in inputs {
+                add(&self.step_output_pass(&input?, &mut counting)?);
             }
         } else {
-            let cached = self.detect_all(frames)?;
+            let cached = self.detect_all(inputs)?;
             self.train(&cached)?;
             self.tracker.start_pass(PassDirection::Forward);
             for (index, detections, detect) in &cached {
                 self.detections.clone_from(detections);
-                let report = self.track(*index, None, *detect, &mut counting)?;
-                detect_time += report.detect_time;
-                track_time += report.track_time;
-                totals.frames += 1;
-                totals.detections += report.detections as u64;
-                on_frame(&report);
+                add(&self.track(*index, None, *detect, &mut counting)?);
             }
         }
         self.tracker.as_tracker().finish(&mut counting)?;
@@ -186,6 +257,42 @@ impl Pipeline {
             totals.track_ms_per_frame = track_time.as_secs_f64() * 1e3 / totals.frames as f64;
         }
         Ok(totals)
+    }
+
+    /// Detects (or takes the detections of) one frame and tracks it, streaming: the points
+    /// that became final go to `sink` now, the rest at [`Pipeline::finish`]. For runs that
+    /// never hold the whole sequence (Python's `ptv_iter`); training passes need the whole
+    /// sequence, so a configuration with `training_passes` > 0 is refused here (use
+    /// [`Pipeline::run`]).
+    pub fn step(&mut self, input: &FrameInput, sink: &mut dyn TrackSink) -> Result<FrameReport> {
+        if self.training_passes > 0 {
+            return Err(Error::parameter(
+                "training_passes",
+                self.training_passes,
+                "a streamed run has a single pass; set it to 0 or run the whole sequence at once",
+            ));
+        }
+        self.step_output_pass(input, &mut CountingSink::new(sink))
+    }
+
+    /// Flushes the points the tracker still holds at the end of a streamed run
+    /// ([`Pipeline::step`]).
+    pub fn finish(&mut self, sink: &mut dyn TrackSink) -> Result<()> {
+        self.tracker.as_tracker().finish(sink)
+    }
+
+    /// One frame of the output pass: observe, then track.
+    fn step_output_pass(
+        &mut self,
+        input: &FrameInput,
+        sink: &mut CountingSink<'_>,
+    ) -> Result<FrameReport> {
+        let detect = self.observe(input)?;
+        let frame = match input {
+            FrameInput::Image(frame) => Some(frame),
+            FrameInput::Detections { .. } => None,
+        };
+        self.track(input.index(), frame, detect, sink)
     }
 
     /// Feeds `self.detections` of frame `index` to the tracker, with the image the detector saw
@@ -220,18 +327,18 @@ impl Pipeline {
     /// trains the tracker on them.
     fn detect_all(
         &mut self,
-        frames: impl Iterator<Item = Result<Frame>>,
+        inputs: impl Iterator<Item = Result<FrameInput>>,
     ) -> Result<Vec<(FrameIndex, Vec<Detection>, Duration)>> {
         let mut cached = Vec::new();
         self.tracker.start_pass(PassDirection::Forward);
-        for frame in frames {
-            let frame = frame?;
-            let detect = self.detect(&frame)?;
-            let observations = FrameObservations::from_detections(frame.index, &self.detections);
+        for input in inputs {
+            let input = input?;
+            let detect = self.observe(&input)?;
+            let observations = FrameObservations::from_detections(input.index(), &self.detections);
             self.tracker
                 .as_tracker()
                 .step(&observations, &mut DiscardSink)?;
-            cached.push((frame.index, self.detections.clone(), detect));
+            cached.push((input.index(), self.detections.clone(), detect));
         }
         Ok(cached)
     }
