@@ -1,0 +1,327 @@
+"""sillage: track many moving objects in image sequences, from Python.
+
+Fast particle tracking velocimetry (TracTrac's algorithm) implemented in Rust, returning
+pandas DataFrames with trackpy's column names (``frame``, ``particle``, ``x``, ``y``), so that
+``trackpy.emsd``, ``trackpy.filter_stubs`` or ``trackpy.plot_traj`` take them as they are.
+
+Frames are numpy arrays: one 2-D frame, a 3-D stack ``(frames, rows, columns)`` or a list of
+2-D frames, of ``uint8`` (divided by 255), ``uint16`` (divided by 65535) or ``float32`` /
+``float64`` (taken as grey levels, 1 being full scale). They are read in place; the GIL is
+released while sillage computes.
+
+Parameters are the keys of sillage's configuration (``sillage config`` on the command line
+lists them all with their defaults): a keyword names a key of the function's own section
+(``detector`` for :func:`locate` and :func:`batch`, ``tracker`` for :func:`link`; for
+:func:`ptv` the one section holding that key), ``section__key`` names any key, and the
+``params`` dict takes dotted keys. Nested values are dicts::
+
+    sillage.batch(frames, scale_px=2.5, threshold={"fixed": 0.02})
+    sillage.ptv(frames, scale_px=2.5, motion_av=5, params={"preprocess.median": 3})
+
+An unknown key or a bad value raises ``ValueError`` naming the key.
+
+Example (the README's)::
+
+    >>> import sillage, trackpy
+    >>> frames, truth = sillage.synth_vortex(particles=500, frames=8, seed=1)
+    >>> tracks = sillage.ptv(frames, scale_px=2.0)
+    >>> msd = trackpy.emsd(trackpy.filter_stubs(tracks, 3), mpp=1.0, fps=1.0)
+"""
+
+from __future__ import annotations
+
+import json
+import numbers
+import sys
+from typing import Any, Iterable, Iterator, Mapping
+
+import numpy as np
+import pandas as pd
+
+from . import _sillage
+
+__version__ = _sillage.__version__
+
+__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "synth_vortex", "config_keys"]
+
+#: Column order of detections (trackpy's ``locate`` puts ``y`` before ``x``).
+_DETECTION_COLUMNS = ["y", "x", "signal", "frame"]
+#: Column order of trajectories.
+_TRACK_COLUMNS = ["y", "x", "frame", "particle", "vx", "vy", "ax", "ay"]
+
+
+def config_keys() -> list[str]:
+    """Every configuration key, dotted (``detector.scale_px``), optional ones included.
+
+    >>> "tracker.motion_av" in sillage.config_keys()
+    True
+    """
+    return list(_sillage.config_keys())
+
+
+def locate(frame: np.ndarray, *, params: Mapping[str, Any] | None = None,
+           **detector: Any) -> pd.DataFrame:
+    """Detects the objects of one 2-D frame.
+
+    Returns a DataFrame with one row per object: ``y``, ``x`` (sub-pixel centre, px; origin
+    at the centre of the top-left pixel), ``signal`` (the band-pass filtered intensity at
+    the centre) and ``frame`` (0). Keywords are ``detector`` keys (``scale_px``,
+    ``threshold``, ``polarity``...), ``params`` any dotted keys.
+
+    >>> spots = sillage.locate(frame, scale_px=2.0)
+    >>> spots[["x", "y"]].head()
+    """
+    array = np.asarray(frame)
+    if array.ndim != 2:
+        raise ValueError(
+            f"locate takes one 2-D frame (rows, columns); got a {array.ndim}-D array of shape "
+            f"{array.shape}; use sillage.batch for a stack of frames")
+    return batch(array, params=params, **detector)
+
+
+def batch(frames: np.ndarray | Iterable[np.ndarray], *,
+          params: Mapping[str, Any] | None = None, progress: bool = False,
+          **detector: Any) -> pd.DataFrame:
+    """Detects the objects of every frame, like ``trackpy.batch``.
+
+    ``frames`` is a 3-D array ``(frames, rows, columns)``, a 2-D frame or an iterable of 2-D
+    frames of one shape. Returns the columns of :func:`locate`, ``frame`` being the frame's
+    position in ``frames``. ``progress=True`` shows a progress bar (tqdm when installed).
+
+    >>> features = sillage.batch(frames, scale_px=2.0)
+    >>> features.groupby("frame").size()
+    """
+    source = _frames_argument(frames)
+    with _progress(progress, _frame_count(source), "locate") as update:
+        columns = _sillage.locate(source, _overrides(detector, params, "detector"), update)
+    return pd.DataFrame(columns)[_DETECTION_COLUMNS]
+
+
+def ptv(frames: np.ndarray | Iterable[np.ndarray] | str, *,
+        params: Mapping[str, Any] | None = None, progress: bool = False,
+        **keywords: Any) -> pd.DataFrame:
+    """Detects and tracks objects through a sequence (TracTrac's PTV).
+
+    ``frames`` is what :func:`batch` takes, or a path: a folder of images, a glob pattern
+    (``"run/*.tif"``), a multi-page TIFF or a video. Returns one row per track point:
+    ``y``, ``x`` (px), ``frame``, ``particle`` (the trajectory id), ``vx``, ``vy``
+    (px/frame) and ``ax``, ``ay`` (px/frame²). As in TracTrac, a point is reported when it
+    is the middle of three linked frames, so the first and last frame carry none.
+
+    Keywords name a key of the ``detector`` or ``tracker`` section (``scale_px``,
+    ``motion_av``...), or ``section__key`` where the name is in both (``tracker__filter``);
+    ``params`` takes dotted keys.
+
+    >>> tracks = sillage.ptv("experiment/*.tif", scale_px=2.5, motion_av=5)
+    >>> trackpy.filter_stubs(tracks, 5)
+    """
+    source = frames if isinstance(frames, str) else _frames_argument(frames)
+    if hasattr(source, "__fspath__"):
+        source = str(source)
+    total = None if isinstance(source, str) else _frame_count(source)
+    with _progress(progress, total, "ptv") as update:
+        columns = _sillage.ptv(source, _overrides(keywords, params, None), update)
+    return pd.DataFrame(columns)[_TRACK_COLUMNS]
+
+
+def ptv_iter(frames: Iterable[np.ndarray] | str, *,
+             params: Mapping[str, Any] | None = None,
+             **keywords: Any) -> Iterator[pd.DataFrame]:
+    """Tracks a sequence frame by frame, yielding as it goes: for long sequences.
+
+    ``frames`` is a path (as for :func:`ptv`) or any iterable of 2-D arrays (a pims
+    sequence, a generator): only a few frames are ever held in memory. After each frame it
+    yields the track points that became final, in the columns of :func:`ptv` (frame t-1's
+    points once frame t is seen; so the DataFrames of all steps, concatenated, equal what
+    :func:`ptv` returns). Keywords as for :func:`ptv`; ``training_passes`` must stay 0.
+
+    >>> for points in sillage.ptv_iter("long_run/*.tif", scale_px=2.5):
+    ...     update_statistics(points)
+    """
+    overrides = _overrides(keywords, params, None)
+    if hasattr(frames, "__fspath__"):
+        frames = str(frames)
+    if isinstance(frames, str):
+        stream = _sillage.PtvStream(overrides, frames)
+        steps: Iterable[Any] = iter(stream.step, None)
+    else:
+        stream = _sillage.PtvStream(overrides)
+        steps = (stream.step(np.asarray(frame)) for frame in frames)
+    for columns in steps:
+        yield pd.DataFrame(columns)[_TRACK_COLUMNS]
+    last = pd.DataFrame(stream.finish())[_TRACK_COLUMNS]
+    if len(last):
+        yield last
+
+
+def link(features: pd.DataFrame, *, params: Mapping[str, Any] | None = None,
+         progress: bool = False, **tracker: Any) -> pd.DataFrame:
+    """Links detections into trajectories with the PTV tracker, like ``trackpy.link``.
+
+    ``features`` has one row per detection with columns ``frame`` (integers), ``x`` and
+    ``y`` (px), e.g. the output of :func:`batch` or ``trackpy.batch``. Returns a copy with
+    a ``particle`` column (every row gets one; rows in no trajectory get ids of their own,
+    as in trackpy) and the velocities ``vx``, ``vy`` (px/frame, NaN where unlinked).
+    Keywords are ``tracker`` keys (``motion_av``, ``max_displacement_px``...). There is no
+    ``search_range``: PTV links nearest neighbours around a predicted position.
+
+    >>> tracks = sillage.link(trackpy.batch(frames, 7), max_displacement_px=5)
+    """
+    missing = [c for c in ("frame", "x", "y") if c not in features.columns]
+    if missing:
+        raise ValueError(
+            f"the detections lack the column(s) {missing}; give a DataFrame with columns "
+            f"frame, x, y (trackpy's layout)")
+    frame = features["frame"].to_numpy()
+    if not np.issubdtype(frame.dtype, np.integer):
+        if not np.all(np.isfinite(frame)) or not np.all(np.mod(frame, 1) == 0):
+            raise ValueError("the frame column must hold whole numbers")
+    frame = np.ascontiguousarray(frame, dtype=np.int64)
+    x = np.ascontiguousarray(features["x"].to_numpy(), dtype=np.float64)
+    y = np.ascontiguousarray(features["y"].to_numpy(), dtype=np.float64)
+    with _progress(progress, int(np.unique(frame).size), "link") as update:
+        columns = _sillage.link(frame, x, y, _overrides(tracker, params, "tracker"), update)
+    linked = features.copy()
+    for name, values in columns.items():
+        linked[name] = values
+    return linked
+
+
+def synth_vortex(**params: Any) -> tuple[np.ndarray, pd.DataFrame]:
+    """Renders the synthetic vortex flow of the TracTrac paper (§4.1.1), with ground truth.
+
+    Keywords are the generator's keys: ``width``, ``height`` (px, default 1024),
+    ``n_particles`` (1000), ``n_frames`` (100), ``delta`` (the time step, 0.01), ``snr`` (4),
+    ``intermittency`` (0), ``brownian`` (0), ``blob_sigma_px`` (2), ``peak`` (0.5), ``seed``
+    (0). Returns the frames, a float32 array ``(frames, rows, columns)`` of grey levels in
+    [0, 1], and the truth: one row per particle and frame with ``frame``, ``particle``,
+    ``x``, ``y`` and the true displacement to the next frame ``vx``, ``vy``.
+
+    >>> frames, truth = sillage.synth_vortex(n_particles=500, n_frames=8, seed=1)
+    >>> frames.shape
+    (8, 1024, 1024)
+    """
+    assignments: list[str] = []
+    for name, value in params.items():
+        _assign(name, value, assignments)
+    frames, truth = _sillage.synth_vortex(assignments)
+    return frames, pd.DataFrame(truth)
+
+
+def _frames_argument(frames: Any) -> Any:
+    """An array as is; any other iterable of frames as a list of arrays."""
+    if isinstance(frames, np.ndarray):
+        return frames
+    if isinstance(frames, (str, bytes)) or not isinstance(frames, Iterable):
+        raise TypeError(
+            f"frames must be a numpy array or an iterable of 2-D arrays, not "
+            f"{type(frames).__name__}")
+    return [np.asarray(frame) for frame in frames]
+
+
+def _frame_count(frames: Any) -> int:
+    if isinstance(frames, np.ndarray):
+        return 1 if frames.ndim == 2 else len(frames)
+    return len(frames)
+
+
+def _overrides(keywords: Mapping[str, Any], params: Mapping[str, Any] | None,
+               section: str | None) -> list[str]:
+    """``key=value`` overrides with dotted keys, values written as TOML."""
+    assignments: list[str] = []
+    keys = None
+    for name, value in keywords.items():
+        if "__" in name:
+            dotted = name.replace("__", ".")
+        elif section is not None:
+            dotted = f"{section}.{name}"
+        else:
+            keys = keys if keys is not None else config_keys()
+            dotted = _resolve(name, keys)
+        _assign(dotted, value, assignments)
+    for key, value in (params or {}).items():
+        _assign(key, value, assignments)
+    return assignments
+
+
+def _resolve(name: str, keys: list[str]) -> str:
+    """The dotted key a bare keyword of :func:`ptv` names."""
+    def owns(key: str, prefix: str) -> bool:
+        return key == prefix or key.startswith(prefix + ".")
+
+    if any(owns(key, name) for key in keys):
+        return name
+    sections = sorted({key.split(".")[0] for key in keys
+                       if "." in key and owns(key, key.split(".")[0] + "." + name)})
+    if len(sections) == 1:
+        return f"{sections[0]}.{name}"
+    if not sections:
+        raise ValueError(
+            f"unknown parameter `{name}`; sillage.config_keys() lists every key "
+            f"(write section__key or use params={{'section.key': value}})")
+    raise ValueError(
+        f"parameter `{name}` is in several sections ({', '.join(sections)}); write "
+        + " or ".join(f"{s}__{name}" for s in sections))
+
+
+def _assign(key: str, value: Any, assignments: list[str]) -> None:
+    """Appends ``key=value`` (nested dicts become dotted keys)."""
+    if isinstance(value, Mapping):
+        for sub, sub_value in value.items():
+            _assign(f"{key}.{sub}", sub_value, assignments)
+        return
+    assignments.append(f"{key}={_toml(key, value)}")
+
+
+def _toml(key: str, value: Any) -> str:
+    """``value`` as a TOML value."""
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        number = float(value)
+        if np.isnan(number):
+            return "nan"
+        if np.isinf(number):
+            return "inf" if number > 0 else "-inf"
+        return repr(number)
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml(key, v) for v in value) + "]"
+    raise ValueError(
+        f"parameter `{key}`: cannot use a value of type {type(value).__name__}; give a "
+        f"number, a bool, a string, a list or a dict")
+
+
+class _progress:
+    """A progress bar updated once per frame (tqdm when installed, else a line on stderr);
+    yields its ``update`` callable, or None when ``enabled`` is false."""
+
+    def __init__(self, enabled: bool, total: int | None, description: str) -> None:
+        self.enabled, self.total, self.description = enabled, total, description
+        self.bar: Any = None
+        self.done = 0
+
+    def __enter__(self):
+        if not self.enabled:
+            return None
+        try:
+            from tqdm.auto import tqdm
+        except ImportError:
+            return self._print
+        self.bar = tqdm(total=self.total, desc=self.description, unit="frame")
+        return self.bar.update
+
+    def _print(self, n: int) -> None:
+        self.done += n
+        of = f"/{self.total}" if self.total else ""
+        print(f"\r{self.description}: {self.done}{of} frames", end="", file=sys.stderr,
+              flush=True)
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.bar is not None:
+            self.bar.close()
+        elif self.enabled:
+            print(file=sys.stderr)

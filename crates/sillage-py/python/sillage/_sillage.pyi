@@ -1,0 +1,27 @@
+"""Type stubs of the native module (the public API is in ``sillage/__init__.py``)."""
+
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+__version__: str
+
+Columns = dict[str, np.ndarray]
+Progress = Optional[Callable[[int], Any]]
+
+def config_keys() -> list[str]: ...
+def locate(frames: Any, overrides: list[str], progress: Progress = None) -> Columns: ...
+def ptv(source: Any, overrides: list[str], progress: Progress = None) -> Columns: ...
+def link(
+    frame: np.ndarray,
+    x: np.ndarray,
+    y: np.ndarray,
+    overrides: list[str],
+    progress: Progress = None,
+) -> Columns: ...
+def synth_vortex(overrides: list[str]) -> tuple[np.ndarray, Columns]: ...
+
+class PtvStream:
+    def __init__(self, overrides: list[str], path: Optional[str] = None) -> None: ...
+    def step(self, frame: Optional[np.ndarray] = None) -> Optional[Columns]: ...
+    def finish(self) -> Columns: ...

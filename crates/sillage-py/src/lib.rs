@@ -1,0 +1,198 @@
+//! `sillage._sillage`, the native half of the `sillage` Python package: numpy in, columns of
+//! numpy arrays out (the pure-Python half, `python/sillage/__init__.py`, makes DataFrames of
+//! them and maps keyword arguments to configuration keys). Every function releases the GIL
+//! while it computes, taking it back between frames only to check for Ctrl-C and to advance
+//! the progress bar.
+
+mod errors;
+mod frames;
+mod hooks;
+mod linking;
+mod stream;
+mod synth;
+
+use numpy::{IntoPyArray, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use sillage::config::OPTIONAL_KEYS;
+use sillage::core::TrackPoint;
+use sillage::io::{FrameOptions, open_frames};
+use sillage::toml_config::dotted_keys;
+use sillage::{Pipeline, PipelineConfig};
+
+use crate::errors::to_py;
+use crate::frames::{FrameArrays, frames_of};
+use crate::hooks::Between;
+
+/// The configuration of `overrides` (`key=value` with dotted keys) on the defaults, validated;
+/// a bad key or value raises `ValueError` naming the key.
+fn config_of(overrides: &[String]) -> PyResult<PipelineConfig> {
+    let mut config = PipelineConfig::default();
+    for assignment in overrides {
+        config.set(assignment).map_err(to_py)?;
+    }
+    config.validate().map_err(to_py)?;
+    Ok(config)
+}
+
+/// Every configuration key, dotted (`detector.scale_px`), the optional ones included.
+#[pyfunction]
+fn config_keys() -> PyResult<Vec<String>> {
+    let mut keys: Vec<String> = dotted_keys(&PipelineConfig::default())
+        .map_err(to_py)?
+        .into_iter()
+        .map(|(key, _)| key)
+        .collect();
+    keys.extend(OPTIONAL_KEYS.iter().map(|(key, _, _)| key.to_string()));
+    Ok(keys)
+}
+
+/// Detects objects in every frame of `frames` (see `frames::FrameArrays::borrow`); returns
+/// the columns `frame`, `x`, `y`, `signal`.
+#[pyfunction]
+#[pyo3(signature = (frames, overrides, progress=None))]
+fn locate<'py>(
+    py: Python<'py>,
+    frames: &Bound<'py, PyAny>,
+    overrides: Vec<String>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = config_of(&overrides)?;
+    let arrays = FrameArrays::borrow(frames)?;
+    let views = arrays.views()?;
+    let (frame, x, y, signal) = py.detach(|| {
+        let between = Between::new(progress);
+        let run = || {
+            let mut pipeline = Pipeline::from_config(&config)?;
+            let (mut frame, mut x, mut y, mut signal) = (vec![], vec![], vec![], vec![]);
+            for image in between.frames(frames_of(&views)) {
+                let image = image?;
+                for d in pipeline.locate(&image)? {
+                    frame.push(image.index as i64);
+                    x.push(d.pos_px.x);
+                    y.push(d.pos_px.y);
+                    signal.push(f64::from(d.strength));
+                }
+                between.advance();
+            }
+            Ok((frame, x, y, signal))
+        };
+        between.result(run())
+    })?;
+    let columns = PyDict::new(py);
+    columns.set_item("frame", frame.into_pyarray(py))?;
+    columns.set_item("x", x.into_pyarray(py))?;
+    columns.set_item("y", y.into_pyarray(py))?;
+    columns.set_item("signal", signal.into_pyarray(py))?;
+    Ok(columns)
+}
+
+/// Detects and tracks `source` (frames as for `locate`, or a path: a folder, a glob pattern,
+/// a TIFF stack or a video); returns the columns of `track_columns`.
+#[pyfunction]
+#[pyo3(signature = (source, overrides, progress=None))]
+fn ptv<'py>(
+    py: Python<'py>,
+    source: &Bound<'py, PyAny>,
+    overrides: Vec<String>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = config_of(&overrides)?;
+    let points = if let Ok(path) = source.extract::<String>() {
+        py.detach(|| {
+            let between = Between::new(progress);
+            let run = || {
+                let mut pipeline = Pipeline::from_config(&config)?;
+                if pipeline.background_init_frames() > 0 {
+                    pipeline.prime_background(open_frames(&path, &FrameOptions::default())?)?;
+                }
+                let frames = open_frames(&path, &FrameOptions::default())?;
+                let mut points: Vec<TrackPoint> = Vec::new();
+                pipeline.run(between.frames(frames), &mut points, &mut |_| {
+                    between.advance()
+                })?;
+                Ok(points)
+            };
+            between.result(run())
+        })?
+    } else {
+        let arrays = FrameArrays::borrow(source)?;
+        let views = arrays.views()?;
+        py.detach(|| {
+            let between = Between::new(progress);
+            let run = || {
+                let mut pipeline = Pipeline::from_config(&config)?;
+                if pipeline.background_init_frames() > 0 {
+                    pipeline.prime_background(frames_of(&views))?;
+                }
+                let mut points: Vec<TrackPoint> = Vec::new();
+                pipeline.run(between.frames(frames_of(&views)), &mut points, &mut |_| {
+                    between.advance()
+                })?;
+                Ok(points)
+            };
+            between.result(run())
+        })?
+    };
+    track_columns(py, &points)
+}
+
+/// The columns of track points: `frame`, `particle`, `x`, `y`, `vx`, `vy`, `ax`, `ay`
+/// (velocities in px/frame, accelerations in px/frame², NaN where not estimated).
+fn track_columns<'py>(py: Python<'py>, points: &[TrackPoint]) -> PyResult<Bound<'py, PyDict>> {
+    let columns = PyDict::new(py);
+    let column = |name: &str, value: &dyn Fn(&TrackPoint) -> f64| {
+        let values: Vec<f64> = points.iter().map(value).collect();
+        columns.set_item(name, values.into_pyarray(py))
+    };
+    let frame: Vec<i64> = points.iter().map(|p| p.frame as i64).collect();
+    let particle: Vec<i64> = points.iter().map(|p| p.track_id as i64).collect();
+    columns.set_item("frame", frame.into_pyarray(py))?;
+    columns.set_item("particle", particle.into_pyarray(py))?;
+    column("x", &|p| p.pos_px.x)?;
+    column("y", &|p| p.pos_px.y)?;
+    column("vx", &|p| p.vel_px_per_frame.map_or(f64::NAN, |v| v.x))?;
+    column("vy", &|p| p.vel_px_per_frame.map_or(f64::NAN, |v| v.y))?;
+    column("ax", &|p| p.acc_px_per_frame2.map_or(f64::NAN, |a| a.x))?;
+    column("ay", &|p| p.acc_px_per_frame2.map_or(f64::NAN, |a| a.y))?;
+    Ok(columns)
+}
+
+/// Links detections given as columns (`frame`, `x`, `y`, one row each) with the PTV
+/// tracker; returns `particle` (a trajectory id per row; rows in no trajectory get ids of
+/// their own, as trackpy gives) and the rows' velocities `vx`, `vy` (NaN where unlinked).
+#[pyfunction]
+#[pyo3(signature = (frame, x, y, overrides, progress=None))]
+fn link<'py>(
+    py: Python<'py>,
+    frame: PyReadonlyArray1<'py, i64>,
+    x: PyReadonlyArray1<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    overrides: Vec<String>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = config_of(&overrides)?;
+    let (frame, x, y) = (frame.as_array(), x.as_array(), y.as_array());
+    let linked = py.detach(|| {
+        let between = Between::new(progress);
+        between.result(linking::link_rows(&config, frame, x, y, &between))
+    })?;
+    let columns = PyDict::new(py);
+    columns.set_item("particle", linked.particle.into_pyarray(py))?;
+    columns.set_item("vx", linked.vx.into_pyarray(py))?;
+    columns.set_item("vy", linked.vy.into_pyarray(py))?;
+    Ok(columns)
+}
+
+/// The native module.
+#[pymodule]
+fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    module.add_function(wrap_pyfunction!(config_keys, module)?)?;
+    module.add_function(wrap_pyfunction!(locate, module)?)?;
+    module.add_function(wrap_pyfunction!(ptv, module)?)?;
+    module.add_function(wrap_pyfunction!(link, module)?)?;
+    module.add_function(wrap_pyfunction!(synth::synth_vortex, module)?)?;
+    module.add_class::<stream::PtvStream>()?;
+    module.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,128 @@
+//! Linking a table of detections (one row per detection, trackpy's layout) with the PTV
+//! tracker, and carrying the trajectory ids back to the rows.
+
+use std::collections::HashMap;
+
+use numpy::ndarray::ArrayView1;
+use sillage::core::{Detection, Error, FrameIndex, Point2, Result, TrackPoint};
+use sillage::{Pipeline, PipelineConfig};
+
+use crate::hooks::Between;
+
+/// Per row: its trajectory id and velocity.
+pub struct LinkedRows {
+    /// Trajectory id; rows in no trajectory get ids of their own after the largest one.
+    pub particle: Vec<i64>,
+    /// Velocity along x, px/frame (NaN where the row is in no trajectory).
+    pub vx: Vec<f64>,
+    /// Velocity along y, px/frame (NaN where the row is in no trajectory).
+    pub vy: Vec<f64>,
+}
+
+/// Links the rows (`frame[i]`, `x[i]`, `y[i]`) frame by frame, in increasing frame order; a
+/// missing frame number is tracked as an empty frame, so no trajectory jumps over it.
+pub fn link_rows(
+    config: &PipelineConfig,
+    frame: ArrayView1<'_, i64>,
+    x: ArrayView1<'_, f64>,
+    y: ArrayView1<'_, f64>,
+    between: &Between,
+) -> Result<LinkedRows> {
+    let rows = frame.len();
+    if x.len() != rows || y.len() != rows {
+        return Err(Error::input(format!(
+            "the frame, x and y columns differ in length ({rows}, {}, {})",
+            x.len(),
+            y.len()
+        )));
+    }
+    if let Some(row) = frame.iter().position(|&f| f < 0) {
+        return Err(Error::input(format!(
+            "row {row} has frame {}; frame numbers must be ≥ 0",
+            frame[row]
+        )));
+    }
+    let mut order: Vec<usize> = (0..rows).collect();
+    order.sort_by_key(|&row| frame[row]);
+
+    // Where each emitted point comes from: (frame, x bits, y bits) → row, the tracker
+    // emitting the detections' own coordinates. Rows at the same place in the same frame are
+    // chained through `same_place`.
+    let key = |row: usize| (frame[row], x[row].to_bits(), y[row].to_bits());
+    let mut row_at: HashMap<(i64, u64, u64), usize> = HashMap::with_capacity(rows);
+    let mut same_place = vec![usize::MAX; rows];
+    for &row in order.iter().rev() {
+        if let Some(next) = row_at.insert(key(row), row) {
+            same_place[row] = next;
+        }
+    }
+
+    let inputs = frame_inputs(&order, frame, x, y);
+    let mut points: Vec<TrackPoint> = Vec::new();
+    let mut pipeline = Pipeline::from_config(config)?;
+    pipeline.run_detections(between.frames(inputs), &mut points, &mut |_| {
+        between.advance()
+    })?;
+
+    let mut linked = LinkedRows {
+        particle: vec![-1; rows],
+        vx: vec![f64::NAN; rows],
+        vy: vec![f64::NAN; rows],
+    };
+    for point in &points {
+        let place = (
+            point.frame as i64,
+            point.pos_px.x.to_bits(),
+            point.pos_px.y.to_bits(),
+        );
+        let row = row_at.get(&place).copied().filter(|&r| r != usize::MAX);
+        let Some(row) = row else {
+            return Err(Error::input(format!(
+                "internal: the tracker emitted a point at ({}, {}) in frame {} that is no row",
+                point.pos_px.x, point.pos_px.y, point.frame
+            )));
+        };
+        row_at.insert(place, same_place[row]);
+        linked.particle[row] = point.track_id as i64;
+        if let Some(v) = point.vel_px_per_frame {
+            linked.vx[row] = v.x;
+            linked.vy[row] = v.y;
+        }
+    }
+    let first_free = linked.particle.iter().max().map_or(0, |&m| m + 1);
+    let unlinked = linked.particle.iter_mut().filter(|p| **p < 0);
+    for (id, particle) in (first_free..).zip(unlinked) {
+        *particle = id;
+    }
+    Ok(linked)
+}
+
+/// The detections of every frame from the first to the last row's, in order (rows sorted by
+/// frame in `order`), with one empty frame standing for each gap in the frame numbers.
+fn frame_inputs<'a>(
+    order: &'a [usize],
+    frame: ArrayView1<'a, i64>,
+    x: ArrayView1<'a, f64>,
+    y: ArrayView1<'a, f64>,
+) -> impl Iterator<Item = Result<(FrameIndex, Vec<Detection>)>> + 'a {
+    let mut start = 0;
+    let mut previous: Option<i64> = None;
+    std::iter::from_fn(move || {
+        let &first = order.get(start)?;
+        let number = frame[first];
+        if let Some(p) = previous
+            && number > p + 1
+        {
+            previous = Some(p + 1);
+            return Some(Ok(((p + 1) as FrameIndex, Vec::new())));
+        }
+        let end = start + order[start..].partition_point(|&row| frame[row] == number);
+        let detections = order[start..end]
+            .iter()
+            .map(|&row| Detection::new(Point2::new(x[row], y[row]), 1.0))
+            .collect();
+        start = end;
+        previous = Some(number);
+        Some(Ok((number as FrameIndex, detections)))
+    })
+}

@@ -1,0 +1,200 @@
+"""Tests of the sillage Python package: layouts trackpy accepts, errors, the README example."""
+
+import pathlib
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+import trackpy
+
+import sillage
+
+README = pathlib.Path(__file__).resolve().parents[3] / "README.md"
+
+
+@pytest.fixture(scope="module")
+def vortex():
+    return sillage.synth_vortex(width=256, height=256, n_particles=200, n_frames=8, seed=3)
+
+
+def readme_python_example() -> str:
+    text = README.read_text(encoding="utf-8")
+    section = text.split("## From Python", 1)[1]
+    blocks = re.findall(r"```python\n(.*?)```", section, flags=re.S)
+    assert blocks, "README.md has no ```python block under '## From Python'"
+    return blocks[0]
+
+
+def test_readme_example_runs():
+    namespace: dict = {}
+    exec(compile(readme_python_example(), "README.md", "exec"), namespace)
+    tracks, msd = namespace["tracks"], namespace["msd"]
+    assert tracks.particle.nunique() > 100
+    assert len(msd) >= 3 and (msd.to_numpy()[:3] > 0).all()
+
+
+def test_synth_vortex_frames_and_truth(vortex):
+    frames, truth = vortex
+    assert frames.shape == (8, 256, 256) and frames.dtype == np.float32
+    assert 0.0 <= frames.min() and frames.max() <= 1.0
+    assert list(truth.columns) == ["frame", "particle", "x", "y", "vx", "vy"]
+    assert (truth.groupby("frame").size() == 200).all()
+
+
+def test_batch_finds_the_true_particles(vortex):
+    frames, truth = vortex
+    features = sillage.batch(frames, scale_px=2.0)
+    assert list(features.columns) == ["y", "x", "signal", "frame"]
+    assert sorted(features.frame.unique()) == list(range(8))
+    first = features[features.frame == 0][["x", "y"]].to_numpy()
+    true = truth[truth.frame == 0][["x", "y"]].to_numpy()
+    nearest = np.sqrt(((true[:, None, :] - first[None, :, :]) ** 2).sum(-1)).min(axis=1)
+    assert (nearest < 1.0).mean() > 0.75  # overlapping spots merge
+
+
+def test_dtypes_and_layouts_give_the_same_detections(vortex):
+    frames, _ = vortex
+    as_u16 = np.round(frames * 65535).astype(np.uint16)
+    reference = sillage.batch(as_u16)
+    for variant in (as_u16.astype(np.float64) / 65535, list(as_u16),
+                    np.asfortranarray(as_u16)):
+        other = sillage.batch(variant)
+        assert len(other) == len(reference)
+        np.testing.assert_allclose(other[["x", "y"]], reference[["x", "y"]], atol=1e-3)
+    single = sillage.locate(as_u16[2])
+    np.testing.assert_allclose(single[["x", "y"]],
+                               reference[reference.frame == 2][["x", "y"]], atol=1e-9)
+    u8 = sillage.batch((frames * 255).astype(np.uint8))
+    assert abs(len(u8) - len(reference)) < 0.1 * len(reference)
+
+
+def test_ptv_passes_through_trackpy(vortex):
+    frames, truth = vortex
+    tracks = sillage.ptv(frames, scale_px=2.0, motion_av=5)
+    assert list(tracks.columns[:4]) == ["y", "x", "frame", "particle"]
+    assert tracks.frame.min() == 1 and tracks.frame.max() == 6
+    stubs = trackpy.filter_stubs(tracks, threshold=6)
+    assert 0 < stubs.particle.nunique() < tracks.particle.nunique() + 1
+    assert (stubs.groupby("particle").size() >= 6).all()
+    msd = trackpy.emsd(stubs, mpp=1.0, fps=1.0)
+    # The vortex moves particles by about a pixel a frame: the MSD grows with the lag.
+    assert np.all(np.diff(msd.to_numpy()) > 0)
+    speed = np.hypot(tracks.vx, tracks.vy)
+    true_speed = np.hypot(truth.vx, truth.vy)
+    assert abs(speed.median() - true_speed.median()) < 0.2 * true_speed.median()
+    trackpy.plot_traj(stubs, plot_style={}).figure.clf() if _has_matplotlib() else None
+
+
+def _has_matplotlib() -> bool:
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        return True
+    except ImportError:
+        return False
+
+
+def test_ptv_reads_a_folder_and_maps_missing_files(tmp_path, vortex):
+    frames, _ = vortex
+    with pytest.raises(FileNotFoundError, match="nothing_here"):
+        sillage.ptv(str(tmp_path / "nothing_here"))
+    stack = tmp_path / "stack.npy"
+    np.save(stack, frames)
+    with pytest.raises(ValueError):
+        sillage.ptv(str(stack))
+
+
+def test_link_matches_ptv_on_its_own_detections(vortex):
+    frames, truth = vortex
+    features = sillage.batch(frames, scale_px=2.0)
+    linked = sillage.link(features, motion_av=5)
+    assert len(linked) == len(features)
+    assert list(linked.columns) == list(features.columns) + ["particle", "vx", "vy"]
+    assert linked.particle.notna().all() and linked.particle.dtype == np.int64
+    tracks = sillage.ptv(frames, scale_px=2.0, motion_av=5)
+    inner = linked[linked.vx.notna()]
+    assert len(inner) == len(tracks)
+    # Rows that link to nothing have ids of their own, as in trackpy.
+    singles = linked[linked.vx.isna()].particle
+    assert singles.min() > inner.particle.max()
+    # Linking the true positions recovers the true trajectories.
+    true_links = sillage.link(truth[["frame", "x", "y"]], motion_av=5)
+    inner = true_links[true_links.vx.notna()].copy()
+    inner["truth"] = truth.particle[inner.index]
+    purity = inner.groupby("particle").truth.nunique()
+    assert (purity == 1).mean() > 0.95
+
+
+def test_link_leaves_gaps_unlinked():
+    rows = [(f, 10.0 + f, 20.0) for f in (0, 1, 2, 3, 5, 6, 7, 8)]
+    df = pd.DataFrame(rows, columns=["frame", "x", "y"])
+    linked = sillage.link(df)
+    before = linked[linked.frame <= 3].particle
+    after = linked[linked.frame >= 5].particle
+    assert not set(before) & set(after)
+
+
+def test_link_errors_name_the_problem():
+    with pytest.raises(ValueError, match="frame"):
+        sillage.link(pd.DataFrame({"x": [1.0], "y": [2.0]}))
+    with pytest.raises(ValueError, match="whole numbers"):
+        sillage.link(pd.DataFrame({"frame": [0.5], "x": [1.0], "y": [2.0]}))
+    with pytest.raises(ValueError, match="tracker.motion_avg"):
+        sillage.link(pd.DataFrame({"frame": [0], "x": [1.0], "y": [2.0]}), motion_avg=3)
+
+
+def test_bad_frames_raise_errors_naming_the_problem(vortex):
+    frames, _ = vortex
+    with pytest.raises(ValueError, match="4-D array"):
+        sillage.batch(np.zeros((2, 3, 4, 5), dtype=np.float32))
+    with pytest.raises(ValueError, match="same shape.*frame 1"):
+        sillage.batch([np.zeros((5, 5), np.uint8), np.zeros((6, 5), np.uint8)])
+    with pytest.raises(ValueError, match="same shape"):
+        sillage.ptv([frames[0], frames[1][:100]])
+    with pytest.raises(TypeError, match="int32"):
+        sillage.batch(np.zeros((4, 4), np.int32))
+    with pytest.raises(ValueError, match="3-D"):
+        sillage.locate(frames)
+
+
+def test_unknown_and_bad_parameters_raise_value_errors_naming_the_key(vortex):
+    frames, _ = vortex
+    with pytest.raises(ValueError, match="detector.scale_pix"):
+        sillage.batch(frames, scale_pix=2.0)
+    with pytest.raises(ValueError, match="unknown parameter `foo`"):
+        sillage.ptv(frames, foo=1)
+    with pytest.raises(ValueError, match="detector__filter or tracker__filter"):
+        sillage.ptv(frames, filter="dog")
+    with pytest.raises(ValueError, match="scale_px"):
+        sillage.batch(frames, scale_px=-1.0)
+    with pytest.raises(ValueError, match="preprocess.medain"):
+        sillage.ptv(frames, params={"preprocess.medain": 3})
+    # Spelled out in every accepted way, the same key has the same effect.
+    a = sillage.ptv(frames, tracker__filter=False)
+    b = sillage.ptv(frames, params={"tracker": {"filter": False}})
+    pd.testing.assert_frame_equal(a, b)
+    fixed = sillage.batch(frames, threshold={"fixed": 0.5})
+    assert len(fixed) < len(sillage.batch(frames))
+
+
+def test_progress_bar_counts_frames(vortex, capsys):
+    frames, _ = vortex
+    sillage.batch(frames, progress=True)
+    assert "8/8" in capsys.readouterr().err
+
+
+def test_ptv_iter_streams_what_ptv_returns(vortex, tmp_path):
+    frames, _ = vortex
+    whole = sillage.ptv(frames, motion_av=5)
+    steps = list(sillage.ptv_iter(iter(frames), motion_av=5))
+    assert len(steps) == len(frames)
+    assert len(steps[0]) == 0 and set(steps[2].frame) == {1}
+    streamed = pd.concat(steps, ignore_index=True)
+    pd.testing.assert_frame_equal(streamed, whole, check_dtype=False)
+    with pytest.raises(ValueError, match="training_passes"):
+        list(sillage.ptv_iter(frames, training_passes=1))
+    with pytest.raises(ValueError, match="same shape"):
+        list(sillage.ptv_iter([frames[0], frames[1][:50]]))
+    with pytest.raises(FileNotFoundError):
+        list(sillage.ptv_iter(str(tmp_path / "missing")))
