@@ -179,7 +179,8 @@ def link(features: pd.DataFrame, *, params: Mapping[str, Any] | None = None,
     frame = np.ascontiguousarray(frame, dtype=np.int64)
     x = np.ascontiguousarray(features["x"].to_numpy(), dtype=np.float64)
     y = np.ascontiguousarray(features["y"].to_numpy(), dtype=np.float64)
-    with _progress(progress, int(np.unique(frame).size), "link") as update:
+    total = int(np.unique(frame).size) if progress else None
+    with _progress(progress, total, "link") as update:
         columns = _sillage.link(frame, x, y, _overrides(tracker, params, "tracker"), update)
     linked = features.copy()
     for name, values in columns.items():
