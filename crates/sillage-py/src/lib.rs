@@ -5,6 +5,7 @@
 //! the progress bar.
 
 mod errors;
+mod eval;
 mod frames;
 mod hooks;
 mod linking;
@@ -193,6 +194,7 @@ fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(link, module)?)?;
     module.add_function(wrap_pyfunction!(synth::synth_vortex, module)?)?;
     module.add_class::<stream::PtvStream>()?;
+    module.add_function(wrap_pyfunction!(eval::evaluate, module)?)?;
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -198,3 +198,22 @@ def test_ptv_iter_streams_what_ptv_returns(vortex, tmp_path):
         list(sillage.ptv_iter([frames[0], frames[1][:50]]))
     with pytest.raises(FileNotFoundError):
         list(sillage.ptv_iter(str(tmp_path / "missing")))
+
+
+def test_evaluate_scores_tracks_against_truth(vortex):
+    frames, truth = vortex
+    perfect = sillage.evaluate(truth, truth)
+    assert perfect["clear"]["mota"] == 1.0 and perfect["identity"]["idf1"] == 1.0
+    tracks = sillage.ptv(frames, motion_av=5)
+    scores = sillage.evaluate(truth, tracks, match_px=1.0)
+    # PTV reports frames 1..6 of 8, so at most 3/4 of the truth is found.
+    assert 0.4 < scores["clear"]["recall"] <= 0.75
+    assert scores["clear"]["precision"] > 0.9
+    assert 0.0 < scores["hota"]["hota"] < 1.0
+    # New ids in every frame: the same detections, identities lost.
+    renamed = tracks.assign(particle=tracks.particle + 1_000_000 * tracks.frame)
+    assert sillage.evaluate(truth, renamed)["identity"]["idf1"] < 0.5 * scores["identity"]["idf1"]
+    with pytest.raises(ValueError, match="particle"):
+        sillage.evaluate(truth, tracks.drop(columns="particle"))
+    with pytest.raises(ValueError, match="match_px"):
+        sillage.evaluate(truth, tracks, match_px=-1.0)

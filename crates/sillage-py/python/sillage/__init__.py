@@ -42,7 +42,7 @@ from . import _sillage
 
 __version__ = _sillage.__version__
 
-__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "synth_vortex", "config_keys"]
+__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "evaluate", "synth_vortex", "config_keys"]
 
 #: Column order of detections (trackpy's ``locate`` puts ``y`` before ``x``).
 _DETECTION_COLUMNS = ["y", "x", "signal", "frame"]
@@ -186,6 +186,33 @@ def link(features: pd.DataFrame, *, params: Mapping[str, Any] | None = None,
     for name, values in columns.items():
         linked[name] = values
     return linked
+
+
+def evaluate(truth: pd.DataFrame, tracks: pd.DataFrame, *, match_px: float = 1.0) -> dict:
+    """CLEAR MOT, IDF1 and HOTA of ``tracks`` against ``truth`` (TrackEval's conventions).
+
+    Both tables have one row per point with ``frame``, ``particle``, ``x``, ``y`` (trackpy's
+    layout; the truth of :func:`synth_vortex`, the output of :func:`ptv` or ``trackpy.link``).
+    A track point matches a true one within ``match_px`` pixels. Returns
+    ``{"clear": {"mota", "motp", "id_switches", ...}, "identity": {"idf1", ...},
+    "hota": {"hota", "det_a", "ass_a", "loc_a", ...}}`` (HOTA averaged over the localisation
+    thresholds, and per threshold).
+
+    >>> scores = sillage.evaluate(truth, sillage.ptv(frames), match_px=1.0)
+    >>> scores["clear"]["mota"], scores["identity"]["idf1"]
+    """
+    def columns(table: pd.DataFrame, name: str) -> tuple[np.ndarray, ...]:
+        missing = [c for c in ("frame", "particle", "x", "y") if c not in table.columns]
+        if missing:
+            raise ValueError(f"{name} lacks the column(s) {missing}; give frame, particle, x, y")
+        return (np.ascontiguousarray(table["frame"], dtype=np.int64),
+                np.ascontiguousarray(table["particle"], dtype=np.int64),
+                np.ascontiguousarray(table["x"], dtype=np.float64),
+                np.ascontiguousarray(table["y"], dtype=np.float64))
+
+    metrics = _sillage.evaluate(columns(truth, "truth"), columns(tracks, "tracks"),
+                                float(match_px))
+    return json.loads(metrics)
 
 
 def synth_vortex(**params: Any) -> tuple[np.ndarray, pd.DataFrame]:
