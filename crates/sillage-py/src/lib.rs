@@ -4,6 +4,7 @@
 //! while it computes, taking it back between frames only to check for Ctrl-C and to advance
 //! the progress bar.
 
+mod bedload;
 mod errors;
 mod eval;
 mod frames;
@@ -195,6 +196,7 @@ fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(synth::synth_vortex, module)?)?;
     module.add_class::<stream::PtvStream>()?;
     module.add_function(wrap_pyfunction!(eval::evaluate, module)?)?;
+    module.add_function(wrap_pyfunction!(bedload::track_bedload, module)?)?;
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -217,3 +217,21 @@ def test_evaluate_scores_tracks_against_truth(vortex):
         sillage.evaluate(truth, tracks.drop(columns="particle"))
     with pytest.raises(ValueError, match="match_px"):
         sillage.evaluate(truth, tracks, match_px=-1.0)
+
+
+def test_track_bedload_follows_beads_with_states():
+    rows = []
+    for frame in range(30):
+        rows.append((frame, 100 + 2.0 * frame, 200.0, 0))  # a moving black bead
+        rows.append((frame, 300.0, 150.0, 1))  # a transparent bead at rest
+    beads = pd.DataFrame(rows, columns=["frame", "x", "y", "class"])
+    for tracker in ("mmpf_plus", "det"):
+        tracks = sillage.track_bedload(beads, tracker=tracker, seed=1)
+        assert len(tracks) == 60 and tracks.particle.nunique() == 2
+        at_rest = tracks[tracks["class"] == 1]
+        assert (at_rest.state == "resting").mean() > 0.9
+        moving = tracks[tracks["class"] == 0]
+        assert (moving.state == "resting").sum() == 0
+        assert np.allclose(moving.x.to_numpy(), 100 + 2.0 * moving.frame.to_numpy(), atol=1.5)
+    with pytest.raises(ValueError, match="trackr"):
+        sillage.track_bedload(beads, trackr="det")

@@ -42,7 +42,7 @@ from . import _sillage
 
 __version__ = _sillage.__version__
 
-__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "evaluate", "synth_vortex", "config_keys"]
+__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "track_bedload", "evaluate", "synth_vortex", "config_keys"]
 
 #: Column order of detections (trackpy's ``locate`` puts ``y`` before ``x``).
 _DETECTION_COLUMNS = ["y", "x", "signal", "frame"]
@@ -186,6 +186,43 @@ def link(features: pd.DataFrame, *, params: Mapping[str, Any] | None = None,
     for name, values in columns.items():
         linked[name] = values
     return linked
+
+
+def track_bedload(detections: pd.DataFrame, *, candidates: pd.DataFrame | None = None,
+                  params: Mapping[str, Any] | None = None, **keywords: Any) -> pd.DataFrame:
+    """Tracks beads with MMPF+ or a baseline of its Table 1 (``tracker="mmpf"``, ``"pf"``,
+    ``"imm"``, ``"det"``), with motion states.
+
+    ``detections`` has one row per detected bead: ``frame``, ``x``, ``y`` (px), and
+    optionally ``class`` (0 black, 1 transparent; default 0) and ``score`` (default 1).
+    ``candidates`` (same columns) are the detector-confidence candidates of Eq. (1). Keywords
+    are keys of the bedload configuration (``sillage track bedload --help``; e.g. ``seed``,
+    ``radius_px=[15, 10]``, ``survival={"max_missed": 5}``). Returns the columns of
+    :func:`ptv` plus ``state`` (resting, rolling, saltating, unknown) and ``class``.
+
+    >>> beads = sillage.track_bedload(detections, tracker="mmpf_plus", seed=1)
+    >>> beads.groupby("state").size()
+    """
+    def columns(table: pd.DataFrame, name: str) -> tuple[np.ndarray, ...]:
+        missing = [c for c in ("frame", "x", "y") if c not in table.columns]
+        if missing:
+            raise ValueError(f"{name} lacks the column(s) {missing}; give frame, x, y")
+        n = len(table)
+        return (np.ascontiguousarray(table["frame"], dtype=np.int64),
+                np.ascontiguousarray(table["x"], dtype=np.float64),
+                np.ascontiguousarray(table["y"], dtype=np.float64),
+                np.ascontiguousarray(table["class"] if "class" in table else np.zeros(n),
+                                     dtype=np.int64),
+                np.ascontiguousarray(table["score"] if "score" in table else np.ones(n),
+                                     dtype=np.float64))
+
+    overrides: list[str] = []
+    for key, value in {**keywords, **(params or {})}.items():
+        _assign(key.replace("__", "."), value, overrides)
+    found = columns(detections, "detections")
+    extra = None if candidates is None else columns(candidates, "candidates")
+    result = _sillage.track_bedload(found, overrides, extra)
+    return pd.DataFrame(result)[_TRACK_COLUMNS + ["state", "class"]]
 
 
 def evaluate(truth: pd.DataFrame, tracks: pd.DataFrame, *, match_px: float = 1.0) -> dict:

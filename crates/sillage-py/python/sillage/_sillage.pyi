@@ -31,3 +31,8 @@ def evaluate(
     tracks: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
     match_px: float,
 ) -> str: ...
+def track_bedload(
+    detections: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    overrides: list[str],
+    candidates: Optional[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = None,
+) -> Columns: ...
