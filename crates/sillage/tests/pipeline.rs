@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use sillage::core::{GrayImage, Point2, TrackPoint};
 use sillage::io::Frame;
 use sillage::synth::{Noise, NoiseKind, render_spots};
-use sillage::{Pipeline, PipelineConfig};
+use sillage::{FrameInput, Pipeline, PipelineConfig};
 
 const SIZE: usize = 160;
 
@@ -173,4 +173,51 @@ fn out_of_range_parameters_are_refused_before_any_work() {
     config.set("training_passes=99").unwrap();
     let err = Pipeline::from_config(&config).err().unwrap().to_string();
     assert!(err.contains("training_passes"), "{err}");
+}
+
+#[test]
+fn streaming_and_detection_runs_give_the_tracks_of_a_whole_run() {
+    let config = PipelineConfig::default();
+    let whole = run(&config, drifting_frames(10));
+
+    let mut streamed = Vec::new();
+    let mut pipeline = Pipeline::from_config(&config).unwrap();
+    for frame in drifting_frames(10) {
+        pipeline
+            .step(&FrameInput::Image(frame), &mut streamed)
+            .unwrap();
+    }
+    pipeline.finish(&mut streamed).unwrap();
+    assert_eq!(streamed, whole);
+
+    // Detections made by `locate`, then tracked on their own.
+    let mut locator = Pipeline::from_config(&config).unwrap();
+    let detections: Vec<_> = drifting_frames(10)
+        .iter()
+        .map(|frame| Ok((frame.index, locator.locate(frame).unwrap().to_vec())))
+        .collect();
+    let mut from_detections = Vec::new();
+    Pipeline::from_config(&config)
+        .unwrap()
+        .run_detections(detections.into_iter(), &mut from_detections, &mut |_| {})
+        .unwrap();
+    assert_eq!(from_detections.len(), whole.len());
+    for (a, b) in from_detections.iter().zip(&whole) {
+        assert_eq!((a.frame, a.track_id), (b.frame, b.track_id));
+        assert!((a.pos_px.x - b.pos_px.x).abs() < 1e-12 && (a.pos_px.y - b.pos_px.y).abs() < 1e-12);
+    }
+
+    // A streamed run has one pass: training passes are refused with the key named.
+    let trained = PipelineConfig {
+        training_passes: 2,
+        ..PipelineConfig::default()
+    };
+    let error = Pipeline::from_config(&trained)
+        .unwrap()
+        .step(
+            &FrameInput::Image(drifting_frames(1).remove(0)),
+            &mut Vec::new(),
+        )
+        .unwrap_err();
+    assert!(error.to_string().contains("training_passes"), "{error}");
 }
