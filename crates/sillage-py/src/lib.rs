@@ -17,7 +17,7 @@ use numpy::{IntoPyArray, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sillage::config::OPTIONAL_KEYS;
-use sillage::core::TrackPoint;
+use sillage::core::{FrameIndex, Point2, TrackId, TrackPoint, Vec2};
 use sillage::io::{FrameOptions, open_frames};
 use sillage::toml_config::dotted_keys;
 use sillage::{Pipeline, PipelineConfig};
@@ -139,24 +139,47 @@ fn ptv<'py>(
     track_columns(py, &points)
 }
 
-/// The columns of track points: `frame`, `particle`, `x`, `y`, `vx`, `vy`, `ax`, `ay`
-/// (velocities in px/frame, accelerations in px/frame², NaN where not estimated).
-fn track_columns<'py>(py: Python<'py>, points: &[TrackPoint]) -> PyResult<Bound<'py, PyDict>> {
+/// One point's identity and motion: frame, track id, position and velocity, px and px/frame.
+type Kinematics = (FrameIndex, TrackId, Point2, Option<Vec2>);
+
+/// The columns `frame`, `particle`, `x`, `y`, `vx`, `vy` (NaN where no velocity) of `points`,
+/// each point read through `kinematics`: shared by tracks and synthetic truth.
+fn kinematic_columns<'py, P>(
+    py: Python<'py>,
+    points: &[P],
+    kinematics: impl Fn(&P) -> Kinematics,
+) -> PyResult<Bound<'py, PyDict>> {
     let columns = PyDict::new(py);
-    let column = |name: &str, value: &dyn Fn(&TrackPoint) -> f64| {
-        let values: Vec<f64> = points.iter().map(value).collect();
-        columns.set_item(name, values.into_pyarray(py))
-    };
-    let frame: Vec<i64> = points.iter().map(|p| p.frame as i64).collect();
-    let particle: Vec<i64> = points.iter().map(|p| p.track_id as i64).collect();
+    let rows: Vec<Kinematics> = points.iter().map(kinematics).collect();
+    let frame: Vec<i64> = rows.iter().map(|r| r.0 as i64).collect();
+    let particle: Vec<i64> = rows.iter().map(|r| r.1 as i64).collect();
     columns.set_item("frame", frame.into_pyarray(py))?;
     columns.set_item("particle", particle.into_pyarray(py))?;
-    column("x", &|p| p.pos_px.x)?;
-    column("y", &|p| p.pos_px.y)?;
-    column("vx", &|p| p.vel_px_per_frame.map_or(f64::NAN, |v| v.x))?;
-    column("vy", &|p| p.vel_px_per_frame.map_or(f64::NAN, |v| v.y))?;
-    column("ax", &|p| p.acc_px_per_frame2.map_or(f64::NAN, |a| a.x))?;
-    column("ay", &|p| p.acc_px_per_frame2.map_or(f64::NAN, |a| a.y))?;
+    let column = |name: &str, value: &dyn Fn(&Kinematics) -> f64| {
+        let values: Vec<f64> = rows.iter().map(value).collect();
+        columns.set_item(name, values.into_pyarray(py))
+    };
+    column("x", &|r| r.2.x)?;
+    column("y", &|r| r.2.y)?;
+    column("vx", &|r| r.3.map_or(f64::NAN, |v| v.x))?;
+    column("vy", &|r| r.3.map_or(f64::NAN, |v| v.y))?;
+    Ok(columns)
+}
+
+/// The columns of track points: those of [`kinematic_columns`], then `ax`, `ay`
+/// (accelerations in px/frame², NaN where not estimated).
+fn track_columns<'py>(py: Python<'py>, points: &[TrackPoint]) -> PyResult<Bound<'py, PyDict>> {
+    let columns = kinematic_columns(py, points, |p| {
+        (p.frame, p.track_id, p.pos_px, p.vel_px_per_frame)
+    })?;
+    let acceleration = |component: fn(Vec2) -> f64| -> Vec<f64> {
+        points
+            .iter()
+            .map(|p| p.acc_px_per_frame2.map_or(f64::NAN, component))
+            .collect()
+    };
+    columns.set_item("ax", acceleration(|a| a.x).into_pyarray(py))?;
+    columns.set_item("ay", acceleration(|a| a.y).into_pyarray(py))?;
     Ok(columns)
 }
 

@@ -9,6 +9,7 @@ use sillage::synth::vortex::{VortexParams, VortexSequence};
 use sillage::toml_config::set_key;
 
 use crate::errors::to_py;
+use crate::kinematic_columns;
 
 /// Renders the vortex flow of the TracTrac paper (§4.1.1) with `overrides` (`key=value`,
 /// keys of `VortexParams`: `width`, `n_particles`, `snr`...); returns the frames as a
@@ -27,19 +28,9 @@ pub fn synth_vortex<'py>(
     let (pixels, truth) = py.detach(|| render(&params)).map_err(to_py)?;
     let frames = Array3::from_shape_vec((params.n_frames, params.height, params.width), pixels)
         .map_err(|e| to_py(Error::input(format!("frames of unexpected size: {e}"))))?;
-    let columns = PyDict::new(py);
-    let column = |name: &str, value: &dyn Fn(&TruthPoint) -> f64| {
-        let values: Vec<f64> = truth.iter().map(value).collect();
-        columns.set_item(name, values.into_pyarray(py))
-    };
-    let frame: Vec<i64> = truth.iter().map(|p| p.frame as i64).collect();
-    let particle: Vec<i64> = truth.iter().map(|p| p.track_id as i64).collect();
-    columns.set_item("frame", frame.into_pyarray(py))?;
-    columns.set_item("particle", particle.into_pyarray(py))?;
-    column("x", &|p| p.pos_px.x)?;
-    column("y", &|p| p.pos_px.y)?;
-    column("vx", &|p| p.vel_px_per_frame.map_or(f64::NAN, |v| v.x))?;
-    column("vy", &|p| p.vel_px_per_frame.map_or(f64::NAN, |v| v.y))?;
+    let columns = kinematic_columns(py, &truth, |p: &TruthPoint| {
+        (p.frame, p.track_id, p.pos_px, p.vel_px_per_frame)
+    })?;
     Ok((frames.into_pyarray(py), columns))
 }
 
