@@ -44,7 +44,7 @@ fn neighbours(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("grid_nn_batch", n), &n, |b, _| {
             b.iter(|| grid.nearest_batch(black_box(&queries), &mut nn))
         });
-        let mut knn_grid = PointIndex::with_occupancy(5.0);
+        let mut knn_grid = PointIndex::with_occupancy(2.0);
         knn_grid.rebuild(&points);
         let mut knn = Vec::new();
         group.bench_with_input(BenchmarkId::new("grid_knn10_batch", n), &n, |b, _| {
@@ -71,5 +71,45 @@ fn neighbours(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, neighbours);
+/// Points per cell against query time at 25,000 points: nearest (default 1) and 10-nearest
+/// (the PTV motion model uses k/5), queries in the raster order a detector emits them.
+fn occupancy(c: &mut Criterion) {
+    let mut group = c.benchmark_group("occupancy");
+    let points = uniform(25_000, 1);
+    let mut queries = uniform(25_000, 2);
+    queries.sort_by(|a, b| {
+        a.y.floor()
+            .total_cmp(&b.y.floor())
+            .then(a.x.total_cmp(&b.x))
+    });
+    let mut nn = Vec::new();
+    for occupancy in [0.5, 1.0, 2.0] {
+        let index = {
+            let mut i = PointIndex::with_occupancy(occupancy);
+            i.rebuild(&points);
+            i
+        };
+        group.bench_with_input(BenchmarkId::new("nn", occupancy), &occupancy, |b, _| {
+            b.iter(|| index.nearest_batch(black_box(&queries), &mut nn))
+        });
+    }
+    let mut sums: Vec<u64> = Vec::new();
+    for occupancy in [1.0, 2.0, 10.0 / 3.0, 5.0] {
+        let index = {
+            let mut i = PointIndex::with_occupancy(occupancy);
+            i.rebuild(&points);
+            i
+        };
+        group.bench_with_input(BenchmarkId::new("knn10", occupancy), &occupancy, |b, _| {
+            b.iter(|| {
+                index.map_k_nearest(black_box(&queries), 10, &mut sums, |ids, _| {
+                    ids.iter().map(|&i| u64::from(i)).sum()
+                })
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, neighbours, occupancy);
 criterion_main!(benches);

@@ -24,8 +24,10 @@ use sillage_core::Point2;
 
 use crate::index::{Neighbour, NeighbourIndex};
 
-/// Default mean number of points per grid cell.
-const DEFAULT_OCCUPANCY: f64 = 2.0;
+/// Default mean number of points per grid cell: the 3×3 block first searched then holds
+/// the nearest point of 96 % of uniform queries (1 − e^−π), and nearest-neighbour batches
+/// run faster than with 2 points per cell (`benches/neighbours.rs`, group `occupancy`).
+const DEFAULT_OCCUPANCY: f64 = 1.0;
 
 /// Largest |cell coordinate| a query is mapped to, so ring arithmetic never overflows.
 const MAX_CELL_COORD: f64 = (1u64 << 40) as f64;
@@ -35,19 +37,6 @@ const STACK_K: usize = 32;
 
 /// Queries per rayon task in [`PointIndex::map_k_nearest`].
 const CHUNK: usize = 256;
-
-/// The 8 cells around a query's cell, nearest first for a query in the upper-right
-/// quarter of its cell (offsets are mirrored for the other quarters).
-const NEIGHBOURS_BY_PROXIMITY: [(i64, i64); 8] = [
-    (1, 0),
-    (0, 1),
-    (1, 1),
-    (-1, 0),
-    (0, -1),
-    (-1, 1),
-    (1, -1),
-    (-1, -1),
-];
 
 /// Index meaning "no point" (never a valid index: an index holds fewer points).
 const NO_POINT: u32 = u32::MAX;
@@ -86,7 +75,7 @@ impl Default for PointIndex {
 }
 
 impl PointIndex {
-    /// An index over `points` (two points per cell on average).
+    /// An index over `points` (one point per cell on average).
     ///
     /// # Panics
     /// If `points` holds 2³² − 1 points or more.
@@ -97,8 +86,8 @@ impl PointIndex {
     }
 
     /// An empty index whose cells will hold `points_per_cell` points on average (values
-    /// that are not finite and positive fall back to 2). About 2 suits nearest-neighbour
-    /// queries, about `k / 2` suits k-nearest queries.
+    /// that are not finite and positive fall back to 1). About 1 suits nearest-neighbour
+    /// queries, about `k / 5` suits k-nearest queries.
     pub fn with_occupancy(points_per_cell: f64) -> Self {
         let occupancy = if points_per_cell.is_finite() && points_per_cell > 0.0 {
             points_per_cell
@@ -276,28 +265,21 @@ impl PointIndex {
         let mut r_first = 0.max(-cx).max(cx - (nx - 1)).max(-cy).max(cy - (ny - 1));
         let r_last = cx.max(nx - 1 - cx).max(cy).max(ny - 1 - cy);
         if r_first == 0 {
-            // Inside the grid: the 3×3 block first, nearest cells first (own cell, then the
-            // neighbours on the query's side), so the k-th best tightens early and farther
-            // cells are skipped or rejected point by point without insertion.
-            let side = |p: f64, origin: f64, c: i64| {
-                if (p - origin) * self.inv_cell - c as f64 >= 0.5 {
-                    1
-                } else {
-                    -1
-                }
+            // Inside the grid: the 3×3 block first, as three row runs (each run of cells is
+            // contiguous in storage), the query's own row first and then the row on its side,
+            // so the k-th best tightens early and farther cells are skipped or rejected point
+            // by point without insertion.
+            let (x_lo, x_hi) = ((cx - 1).max(0) as usize, (cx + 1).min(nx - 1) as usize);
+            let below = (p.y - self.origin.y) * self.inv_cell - (cy as f64) < 0.5;
+            let rows = if below {
+                [cy, cy - 1, cy + 1]
+            } else {
+                [cy, cy + 1, cy - 1]
             };
-            let (sx, sy) = (side(p.x, self.origin.x, cx), side(p.y, self.origin.y, cy));
-            let own = (cy * nx + cx) as usize;
-            self.visit_cells(own, own, visitor);
-            for (dx, dy) in NEIGHBOURS_BY_PROXIMITY {
-                let (x, y) = (cx + dx * sx, cy + dy * sy);
-                if (0..nx).contains(&x) && (0..ny).contains(&y) {
-                    let gx = self.gap(p.x, self.origin.x, x);
-                    let gy = self.gap(p.y, self.origin.y, y);
-                    if gx * gx + gy * gy <= visitor.worst_d2() {
-                        let c = (y * nx + x) as usize;
-                        self.visit_cells(c, c, visitor);
-                    }
+            for y in rows {
+                if (0..ny).contains(&y) {
+                    let row = y as usize * self.nx;
+                    self.visit_cells(row + x_lo, row + x_hi, visitor);
                 }
             }
             if r_last <= 1 {
@@ -348,6 +330,7 @@ impl PointIndex {
     fn visit_cells(&self, first: usize, last: usize, visitor: &mut impl Visitor) {
         let range = self.starts[first] as usize..self.starts[last + 1] as usize;
         visitor.visit(
+            range.start,
             &self.xs[range.clone()],
             &self.ys[range.clone()],
             &self.ids[range],
@@ -375,20 +358,20 @@ impl PointIndex {
         bound - self.slack
     }
 
-    /// The `min(k, len)` nearest points of `p` as (index, squared distance), nearest
-    /// first, written to the front of `d2` / `ids` (both at least that long); returns how
+    /// The `min(k, len)` nearest points of `p` as (squared distance, [`slot_key`]), nearest
+    /// first, written to the front of `d2` / `keys` (both at least that long); returns how
     /// many were found.
     #[inline]
-    fn k_nearest_into(&self, p: Point2, d2: &mut [f64], ids: &mut [u32]) -> usize {
+    fn k_nearest_into(&self, p: Point2, d2: &mut [f64], keys: &mut [u64]) -> usize {
         let mut best = KBest {
             px: p.x,
             py: p.y,
-            k: d2.len().min(ids.len()),
+            k: d2.len().min(keys.len()),
             n: 0,
             d2,
-            ids,
+            keys,
             worst: f64::INFINITY,
-            worst_id: NO_POINT,
+            worst_key: u64::MAX,
         };
         if best.k > 0 {
             self.search(p, &mut best);
@@ -411,17 +394,21 @@ impl PointIndex {
         }
     }
 
-    /// For every query, `f` of the indexes of its `min(k, len)` nearest points, nearest
+    /// For every query, `f(indexes, slots)` of its `min(k, len)` nearest points, nearest
     /// first (ties to the lower index), in parallel; `out[i]` answers `queries[i]`. Same
     /// neighbours as [`NeighbourIndex::k_nearest`], without the distances and without any
     /// per-query allocation; `out` is overwritten and its allocation reused. The result
     /// does not depend on the number of rayon threads.
+    ///
+    /// `slots` are the neighbours' places in the index's cell-sorted storage (see
+    /// [`PointIndex::slot_indexes`]): data laid out in that order is read from a few
+    /// contiguous runs, where data in the original order would be read at random.
     pub fn map_k_nearest<T: Send + Default>(
         &self,
         queries: &[Point2],
         k: usize,
         out: &mut Vec<T>,
-        f: impl Fn(&[u32]) -> T + Sync,
+        f: impl Fn(&[u32], &[u32]) -> T + Sync,
     ) {
         out.clear();
         out.resize_with(queries.len(), T::default);
@@ -430,22 +417,46 @@ impl PointIndex {
             .par_chunks(CHUNK)
             .zip(out.par_chunks_mut(CHUNK))
             .for_each(|(queries, out)| {
-                with_scratch(k, |d2, ids| {
+                with_scratch(k, |d2, keys| {
+                    let (mut ids, mut slots) = (vec![0; k], vec![0; k]);
                     for (&q, o) in queries.iter().zip(out) {
-                        let n = self.k_nearest_into(q, d2, ids);
-                        *o = f(&ids[..n]);
+                        let n = self.k_nearest_into(q, d2, keys);
+                        for ((&key, id), slot) in keys[..n].iter().zip(&mut ids).zip(&mut slots) {
+                            (*id, *slot) = split_key(key);
+                        }
+                        *o = f(&ids[..n], &slots[..n]);
                     }
                 })
             });
     }
+
+    /// The original index of the point held in each storage slot: points are stored sorted
+    /// by cell (row-major), in increasing index order within a cell. Lay per-point data out
+    /// in this order to read it along with [`PointIndex::map_k_nearest`]'s slots.
+    pub fn slot_indexes(&self) -> &[u32] {
+        &self.ids
+    }
+}
+
+/// Packs a point's original index (high half, so that keys order as indexes do) and its
+/// storage slot into one candidate key.
+#[inline]
+fn slot_key(id: u32, slot: usize) -> u64 {
+    (u64::from(id) << 32) | slot as u64
+}
+
+/// (original index, storage slot) of a [`slot_key`].
+#[inline]
+fn split_key(key: u64) -> (u32, u32) {
+    ((key >> 32) as u32, key as u32)
 }
 
 /// Runs `f` on candidate arrays of length `k`: on the stack when `k` ≤ [`STACK_K`].
 #[inline]
-fn with_scratch<R>(k: usize, f: impl FnOnce(&mut [f64], &mut [u32]) -> R) -> R {
+fn with_scratch<R>(k: usize, f: impl FnOnce(&mut [f64], &mut [u64]) -> R) -> R {
     if k <= STACK_K {
-        let (mut d2, mut ids) = ([0.0; STACK_K], [0; STACK_K]);
-        f(&mut d2[..k], &mut ids[..k])
+        let (mut d2, mut keys) = ([0.0; STACK_K], [0; STACK_K]);
+        f(&mut d2[..k], &mut keys[..k])
     } else {
         f(&mut vec![0.0; k], &mut vec![0; k])
     }
@@ -453,8 +464,9 @@ fn with_scratch<R>(k: usize, f: impl FnOnce(&mut [f64], &mut [u32]) -> R) -> R {
 
 /// What a grid search collects.
 trait Visitor {
-    /// Offers the points of a run of cells (coordinates and original indexes).
-    fn visit(&mut self, xs: &[f64], ys: &[f64], ids: &[u32]);
+    /// Offers the points of a run of cells: coordinates and original indexes, held in the
+    /// storage slots `first_slot..`.
+    fn visit(&mut self, first_slot: usize, xs: &[f64], ys: &[f64], ids: &[u32]);
     /// Squared distance a point must not exceed to still matter.
     fn worst_d2(&self) -> f64;
 }
@@ -469,7 +481,7 @@ struct Nearest {
 
 impl Visitor for Nearest {
     #[inline]
-    fn visit(&mut self, xs: &[f64], ys: &[f64], ids: &[u32]) {
+    fn visit(&mut self, _first_slot: usize, xs: &[f64], ys: &[f64], ids: &[u32]) {
         for ((&x, &y), &id) in xs.iter().zip(ys).zip(ids) {
             // Computed as `index::dist2`, so that ties are exact.
             let (dx, dy) = (self.px - x, self.py - y);
@@ -496,7 +508,7 @@ struct Within<F> {
 
 impl<F: FnMut(usize, f64)> Visitor for Within<F> {
     #[inline]
-    fn visit(&mut self, xs: &[f64], ys: &[f64], ids: &[u32]) {
+    fn visit(&mut self, _first_slot: usize, xs: &[f64], ys: &[f64], ids: &[u32]) {
         for ((&x, &y), &id) in xs.iter().zip(ys).zip(ids) {
             let (dx, dy) = (self.px - x, self.py - y);
             let d = dx * dx + dy * dy;
@@ -513,24 +525,25 @@ impl<F: FnMut(usize, f64)> Visitor for Within<F> {
 }
 
 /// Collects the `k` nearest points, sorted by (squared distance, index), by insertion
-/// into fixed arrays.
+/// into fixed arrays. A candidate's key packs its index and storage slot ([`slot_key`]), so
+/// comparing keys compares indexes.
 struct KBest<'a> {
     px: f64,
     py: f64,
     k: usize,
     n: usize,
     d2: &'a mut [f64],
-    ids: &'a mut [u32],
-    /// The k-th best so far (infinite and `NO_POINT` until k are held).
+    keys: &'a mut [u64],
+    /// The k-th best so far (infinite and `u64::MAX` until k are held).
     worst: f64,
-    worst_id: u32,
+    worst_key: u64,
 }
 
 impl KBest<'_> {
     /// Inserts a candidate that ranks before the current k-th best (dropping that one when
     /// k are held), shifting the worse ones up one slot.
     #[inline]
-    fn insert(&mut self, d: f64, id: u32) {
+    fn insert(&mut self, d: f64, key: u64) {
         let mut at = if self.n < self.k {
             self.n += 1;
             self.n - 1
@@ -538,32 +551,35 @@ impl KBest<'_> {
             self.k - 1
         };
         while at > 0 {
-            let (prev_d, prev_id) = (self.d2[at - 1], self.ids[at - 1]);
-            if d < prev_d || (d == prev_d && id < prev_id) {
+            let (prev_d, prev_key) = (self.d2[at - 1], self.keys[at - 1]);
+            if d < prev_d || (d == prev_d && key < prev_key) {
                 self.d2[at] = prev_d;
-                self.ids[at] = prev_id;
+                self.keys[at] = prev_key;
                 at -= 1;
             } else {
                 break;
             }
         }
         self.d2[at] = d;
-        self.ids[at] = id;
+        self.keys[at] = key;
         if self.n == self.k {
             self.worst = self.d2[self.k - 1];
-            self.worst_id = self.ids[self.k - 1];
+            self.worst_key = self.keys[self.k - 1];
         }
     }
 }
 
 impl Visitor for KBest<'_> {
     #[inline]
-    fn visit(&mut self, xs: &[f64], ys: &[f64], ids: &[u32]) {
-        for ((&x, &y), &id) in xs.iter().zip(ys).zip(ids) {
+    fn visit(&mut self, first_slot: usize, xs: &[f64], ys: &[f64], ids: &[u32]) {
+        for (slot, ((&x, &y), &id)) in (first_slot..).zip(xs.iter().zip(ys).zip(ids)) {
             let (dx, dy) = (self.px - x, self.py - y);
             let d = dx * dx + dy * dy;
-            if d <= self.worst && (d < self.worst || id < self.worst_id) {
-                self.insert(d, id);
+            if d <= self.worst {
+                let key = slot_key(id, slot);
+                if d < self.worst || key < self.worst_key {
+                    self.insert(d, key);
+                }
             }
         }
     }
@@ -598,7 +614,7 @@ impl NeighbourIndex for PointIndex {
                 ids[..n]
                     .iter()
                     .zip(&d2[..n])
-                    .map(|(&i, &d)| (i as usize, d.sqrt())),
+                    .map(|(&key, &d)| (split_key(key).0 as usize, d.sqrt())),
             );
         });
     }

@@ -45,7 +45,14 @@ fn check_same(points: &[Point2], queries: &[Point2], k: usize) {
     let mut concat = PointIndex::with_occupancy(3.0);
     concat.rebuild_concat(&points[..points.len() / 3], &points[points.len() / 3..]);
     for index in [&grid, &concat] {
-        index.map_k_nearest(queries, k, &mut mapped, |ids| {
+        // Each slot holds the point it is reported with.
+        let slot_indexes = index.slot_indexes();
+        index.map_k_nearest(queries, k, &mut mapped, |ids, slots| {
+            assert!(
+                ids.iter()
+                    .zip(slots)
+                    .all(|(&i, &s)| slot_indexes[s as usize] == i)
+            );
             ids.iter().map(|&i| i as usize).collect()
         });
         let expected: Vec<Vec<usize>> =

@@ -1,5 +1,6 @@
 //! The PTV tracker: three-frame association, kinematics, outlier filter, id hand-over.
 
+use rayon::prelude::*;
 use sillage_assoc::{Neighbour, NeighbourIndex, PointIndex, mutual_pairs};
 use sillage_core::{
     Error, FrameIndex, FrameObservations, Point2, Result, TrackId, TrackPoint, TrackSink, Tracker,
@@ -19,6 +20,9 @@ use super::voting::voted_displacements;
 /// (δ = 0.05: 88.2 % at 1/32, 88.9 % at 1/16, 90.6 % at 1/8) but hurt a fast solid rotation,
 /// whose centripetal lag they leave uncorrected (recall 0.883, 0.866, 0.844).
 const VOTE_MIN_CORRECTION_SPACINGS: f64 = 0.0625;
+
+/// Fewest points a rayon task handles in the per-point loops (keeps task overhead small).
+const PAR_MIN_LEN: usize = 1024;
 
 /// Direction of a pass over the sequence (TracTrac's `vid_loop` alternates them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -105,6 +109,8 @@ pub struct PtvTracker {
     triplets: Vec<Triplet>,
     errors: Vec<f64>,
     ids1: Vec<Option<TrackId>>,
+    /// (track id, triplet) of the points to emit, sorted into the emission order.
+    emit_order: Vec<(TrackId, usize)>,
     emitted: Vec<TrackPoint>,
 }
 
@@ -145,6 +151,7 @@ impl PtvTracker {
             triplets: Vec::new(),
             errors: Vec::new(),
             ids1: Vec::new(),
+            emit_order: Vec::new(),
             emitted: Vec::new(),
         })
     }
@@ -280,22 +287,27 @@ impl PtvTracker {
     /// reusing frame t's index; without a model the predictions are frame t−1 itself and
     /// its index is reused too.
     fn associate(&mut self, model_applied: bool) {
+        // The predictions' index is built while frame t's index answers the forward queries.
+        let (pred, c2, index_c2) = (&self.pred, &self.c2, &self.index_c2);
+        let (forward, two_nearest) = (&mut self.forward, &mut self.two_nearest);
+        let mut forward_queries = || {
+            if self.params.ambiguity_ratio.is_some() {
+                index_c2.k_nearest_batch(pred, 2, two_nearest);
+                forward.clear();
+                forward.extend(two_nearest.iter().map(|n| n.first().copied()));
+            } else {
+                index_c2.nearest_batch(pred, forward);
+            }
+        };
         let pred_index = if model_applied {
-            self.index_pred.rebuild(&self.pred);
+            let index_pred = &mut self.index_pred;
+            rayon::join(|| index_pred.rebuild(pred), forward_queries);
             &self.index_pred
         } else {
+            forward_queries();
             &self.index_c1
         };
-        if self.params.ambiguity_ratio.is_some() {
-            self.index_c2
-                .k_nearest_batch(&self.pred, 2, &mut self.two_nearest);
-            self.forward.clear();
-            self.forward
-                .extend(self.two_nearest.iter().map(|n| n.first().copied()));
-        } else {
-            self.index_c2.nearest_batch(&self.pred, &mut self.forward);
-        }
-        pred_index.nearest_batch(&self.c2, &mut self.backward);
+        pred_index.nearest_batch(c2, &mut self.backward);
         mutual_pairs(&self.forward, &self.backward, None, &mut self.link12);
         mutual_pairs(&self.backward, &self.forward, None, &mut self.link21);
         if let Some(ratio) = self.params.ambiguity_ratio {
@@ -320,35 +332,47 @@ impl PtvTracker {
     /// Builds the triplets t−2 ↔ t−1 ↔ t, their kinematics and errors, applies the outlier
     /// test and updates the threshold; the kept ones become `current`.
     fn make_tracklets(&mut self, dt: f64) {
+        let (c0, c1, c2) = (&self.c0, &self.c1, &self.c2);
+        let (vel_pred, log_err_pred) = (&self.vel_pred, &self.log_err_pred);
+        let (filter, threshold) = (self.params.filter, self.threshold);
+        // Kinematics in parallel (the log10 dominates), in middle-point order.
         self.triplets.clear();
+        self.triplets.par_extend(
+            self.link01
+                .par_iter()
+                .zip(&self.link12)
+                .enumerate()
+                .with_min_len(PAR_MIN_LEN)
+                .filter_map(|(middle, (&back, &ahead))| {
+                    let (before, after) = (back?, ahead?);
+                    let (x0, x1, x2) = (c0[before], c1[middle], c2[after]);
+                    let u0 = (x1 - x0) / dt;
+                    let u1 = (x2 - x1) / dt;
+                    // Eq. (6): v(t−1) = (x(t) − x(t−2)) / 2Δt, the mean of the two finite
+                    // differences.
+                    let vel = (u0 + u1) * 0.5;
+                    // Eq. (7), whose signs were lost in the text:
+                    // a(t−1) = (x(t) − 2x(t−1) + x(t−2)) / Δt².
+                    let acc = (u1 - u0) / dt;
+                    let log_err = log10_error(vel_pred[middle], vel, dt);
+                    // §3.1.3: outlier when ε − ε̄ ≥ threshold (the threshold stands for
+                    // n_σ·σ̄_ε).
+                    let kept = !filter || log_err - log_err_pred[middle] < threshold;
+                    Some(Triplet {
+                        before,
+                        middle,
+                        vel,
+                        acc,
+                        log_err,
+                        kept,
+                    })
+                }),
+        );
         self.errors.clear();
+        self.errors.extend(self.triplets.iter().map(|t| t.log_err));
         self.current.clear();
-        for (middle, (&back, &ahead)) in self.link01.iter().zip(&self.link12).enumerate() {
-            let (Some(before), Some(after)) = (back, ahead) else {
-                continue;
-            };
-            let (x0, x1, x2) = (self.c0[before], self.c1[middle], self.c2[after]);
-            let u0 = (x1 - x0) / dt;
-            let u1 = (x2 - x1) / dt;
-            // Eq. (6): v(t−1) = (x(t) − x(t−2)) / 2Δt, the mean of the two finite differences.
-            let vel = (u0 + u1) * 0.5;
-            // Eq. (7), whose signs were lost in the text: a(t−1) = (x(t) − 2x(t−1) + x(t−2)) / Δt².
-            let acc = (u1 - u0) / dt;
-            let log_err = log10_error(self.vel_pred[middle], vel, dt);
-            // §3.1.3: outlier when ε − ε̄ ≥ threshold (the threshold stands for n_σ·σ̄_ε).
-            let kept = !self.params.filter || log_err - self.log_err_pred[middle] < self.threshold;
-            self.errors.push(log_err);
-            self.triplets.push(Triplet {
-                before,
-                middle,
-                vel,
-                acc,
-                log_err,
-                kept,
-            });
-            if kept {
-                self.current.push(x1, vel, log_err);
-            }
+        for t in self.triplets.iter().filter(|t| t.kept) {
+            self.current.push(c1[t.middle], t.vel, t.log_err);
         }
         self.threshold = updated_threshold(
             self.threshold,
@@ -360,11 +384,15 @@ impl PtvTracker {
 
     /// §3.1.4: each tracklet takes the id of its t−2 ↔ t−1 link; kept tracklets without one
     /// get a new id; rejected ones still pass an inherited id on. Emits the kept ones.
+    ///
+    ///
+    /// The points are put in id order through (id, triplet) keys rather than by sorting the
+    /// points themselves (16-byte keys instead of whole track points), then built in parallel.
     fn hand_over_ids(&mut self, sink: &mut dyn TrackSink) -> Result<()> {
         self.ids1.clear();
         self.ids1.resize(self.c1.len(), None);
-        self.emitted.clear();
-        for t in &self.triplets {
+        self.emit_order.clear();
+        for (n, t) in self.triplets.iter().enumerate() {
             let mut id = self.ids0[t.before];
             if id.is_none() && t.kept {
                 id = Some(self.next_id);
@@ -372,16 +400,27 @@ impl PtvTracker {
             }
             self.ids1[t.middle] = id;
             if let (Some(track_id), true) = (id, t.kept) {
-                self.emitted.push(TrackPoint {
-                    vel_px_per_frame: Some(t.vel),
-                    acc_px_per_frame2: Some(t.acc),
-                    vel_pred_px_per_frame: Some(self.vel_pred[t.middle]),
-                    log10_pred_err: Some(t.log_err),
-                    ..TrackPoint::at(self.frame_c1, track_id, self.c1[t.middle])
-                });
+                self.emit_order.push((track_id, n));
             }
         }
-        self.emitted.sort_unstable_by_key(|p| p.track_id);
+        // Ids are unique among the emitted points, so the order is total.
+        self.emit_order.sort_unstable();
+        let (triplets, vel_pred, c1, frame) =
+            (&self.triplets, &self.vel_pred, &self.c1, self.frame_c1);
+        self.emit_order
+            .par_iter()
+            .with_min_len(PAR_MIN_LEN)
+            .map(|&(track_id, n)| {
+                let t = &triplets[n];
+                TrackPoint {
+                    vel_px_per_frame: Some(t.vel),
+                    acc_px_per_frame2: Some(t.acc),
+                    vel_pred_px_per_frame: Some(vel_pred[t.middle]),
+                    log10_pred_err: Some(t.log_err),
+                    ..TrackPoint::at(frame, track_id, c1[t.middle])
+                }
+            })
+            .collect_into_vec(&mut self.emitted);
         if self.emitted.is_empty() {
             Ok(())
         } else {
