@@ -71,8 +71,8 @@ fn neighbours(c: &mut Criterion) {
     group.finish();
 }
 
-/// Points per cell against query time at 25,000 points: nearest (default 1) and 10-nearest
-/// (the PTV motion model uses k/5), queries in the raster order a detector emits them.
+/// Points per cell against query time at 25,000 points: nearest (default 1) and 10-nearest,
+/// queries in the raster order a detector emits them.
 fn occupancy(c: &mut Criterion) {
     let mut group = c.benchmark_group("occupancy");
     let points = uniform(25_000, 1);

@@ -358,25 +358,35 @@ impl PointIndex {
         bound - self.slack
     }
 
-    /// The `min(k, len)` nearest points of `p` as (squared distance, [`slot_key`]), nearest
-    /// first, written to the front of `d2` / `keys` (both at least that long); returns how
-    /// many were found.
+    /// The fewest nearest points of `p` that stand for `k` samples together (all points when
+    /// they stand for fewer), as (squared distance, [`slot_key`]), nearest first, written to
+    /// the front of `d2` / `keys` (both at least `k + 1` long: one more for the insertion);
+    /// returns how many points and how many samples they stand for.
     #[inline]
-    fn k_nearest_into(&self, p: Point2, d2: &mut [f64], keys: &mut [u64]) -> usize {
+    fn k_nearest_into<M: Multiplicity>(
+        &self,
+        p: Point2,
+        k: usize,
+        counts: M,
+        d2: &mut [f64],
+        keys: &mut [u64],
+    ) -> (usize, usize) {
         let mut best = KBest {
             px: p.x,
             py: p.y,
-            k: d2.len().min(keys.len()),
+            k,
             n: 0,
+            samples: 0,
+            counts,
             d2,
             keys,
             worst: f64::INFINITY,
             worst_key: u64::MAX,
         };
-        if best.k > 0 {
+        if k > 0 {
             self.search(p, &mut best);
         }
-        best.n
+        (best.n, best.samples)
     }
 
     /// Calls `f(index, squared distance)` for every point within `radius` of `p` (distance
@@ -410,21 +420,68 @@ impl PointIndex {
         out: &mut Vec<T>,
         f: impl Fn(&[u32], &[u32]) -> T + Sync,
     ) {
+        let k = k.min(self.xs.len());
+        self.map_nearest_samples(queries, k, Single, out, |ids, slots, _| f(ids, slots));
+    }
+
+    /// [`PointIndex::map_k_nearest`] over points that each stand for several samples at the
+    /// same place (`counts_by_slot[slot]` ≥ 1 samples, in storage order): for every query,
+    /// `f(slots, last_taken)` of the fewest nearest points whose samples reach `k` (all points
+    /// when they hold fewer), nearest first, ties to the lower index. The last point gives
+    /// only `last_taken` of its samples when the k-th sample falls inside it.
+    ///
+    /// This is the k-nearest of the multiset where each point is repeated, without indexing
+    /// the repeats: the PTV motion model's samples are mostly two per point (a tracklet and
+    /// the stored model at the same position). Repeats of different points at exactly the
+    /// same distance are ordered by point, not interleaved.
+    ///
+    /// # Panics
+    /// If `counts_by_slot` is shorter than the index.
+    pub fn map_k_nearest_counted<T: Send + Default>(
+        &self,
+        queries: &[Point2],
+        k: usize,
+        counts_by_slot: &[u8],
+        out: &mut Vec<T>,
+        f: impl Fn(&[u32], usize) -> T + Sync,
+    ) {
+        assert!(
+            counts_by_slot.len() >= self.xs.len(),
+            "one count per indexed point"
+        );
+        let counts = BySlot(counts_by_slot);
+        self.map_nearest_samples(queries, k, counts, out, |_, slots, samples| {
+            let last_taken = slots.last().map_or(0, |&slot| {
+                let count = counts.of(slot as usize);
+                count - samples.saturating_sub(k).min(count - 1)
+            });
+            f(slots, last_taken)
+        });
+    }
+
+    /// The shared body of the batch k-nearest queries: `f(indexes, slots, samples)`.
+    fn map_nearest_samples<T: Send + Default, M: Multiplicity>(
+        &self,
+        queries: &[Point2],
+        k: usize,
+        counts: M,
+        out: &mut Vec<T>,
+        f: impl Fn(&[u32], &[u32], usize) -> T + Sync,
+    ) {
         out.clear();
         out.resize_with(queries.len(), T::default);
-        let k = k.min(self.xs.len());
         queries
             .par_chunks(CHUNK)
             .zip(out.par_chunks_mut(CHUNK))
             .for_each(|(queries, out)| {
-                with_scratch(k, |d2, keys| {
-                    let (mut ids, mut slots) = (vec![0; k], vec![0; k]);
+                with_scratch(k + 1, |d2, keys| {
+                    let (mut ids, mut slots) = (vec![0; k + 1], vec![0; k + 1]);
                     for (&q, o) in queries.iter().zip(out) {
-                        let n = self.k_nearest_into(q, d2, keys);
+                        let (n, samples) = self.k_nearest_into(q, k, counts, d2, keys);
                         for ((&key, id), slot) in keys[..n].iter().zip(&mut ids).zip(&mut slots) {
                             (*id, *slot) = split_key(key);
                         }
-                        *o = f(&ids[..n], &slots[..n]);
+                        *o = f(&ids[..n], &slots[..n], samples);
                     }
                 })
             });
@@ -451,11 +508,11 @@ fn split_key(key: u64) -> (u32, u32) {
     ((key >> 32) as u32, key as u32)
 }
 
-/// Runs `f` on candidate arrays of length `k`: on the stack when `k` ≤ [`STACK_K`].
+/// Runs `f` on candidate arrays of length `k`: on the stack when `k` ≤ [`STACK_K`] + 1.
 #[inline]
 fn with_scratch<R>(k: usize, f: impl FnOnce(&mut [f64], &mut [u64]) -> R) -> R {
-    if k <= STACK_K {
-        let (mut d2, mut keys) = ([0.0; STACK_K], [0; STACK_K]);
+    if k <= STACK_K + 1 {
+        let (mut d2, mut keys) = ([0.0; STACK_K + 1], [0; STACK_K + 1]);
         f(&mut d2[..k], &mut keys[..k])
     } else {
         f(&mut vec![0.0; k], &mut vec![0; k])
@@ -524,32 +581,68 @@ impl<F: FnMut(usize, f64)> Visitor for Within<F> {
     }
 }
 
-/// Collects the `k` nearest points, sorted by (squared distance, index), by insertion
-/// into fixed arrays. A candidate's key packs its index and storage slot ([`slot_key`]), so
+/// How many samples each indexed point stands for, in the k-nearest searches.
+trait Multiplicity: Copy + Sync {
+    /// Samples of the point in storage slot `slot` (≥ 1).
+    fn of(self, slot: usize) -> usize;
+}
+
+/// Every point is one sample: the plain k-nearest.
+#[derive(Clone, Copy)]
+struct Single;
+
+impl Multiplicity for Single {
+    #[inline]
+    fn of(self, _slot: usize) -> usize {
+        1
+    }
+}
+
+/// Samples per point given in storage order.
+#[derive(Clone, Copy)]
+struct BySlot<'a>(&'a [u8]);
+
+impl Multiplicity for BySlot<'_> {
+    #[inline]
+    fn of(self, slot: usize) -> usize {
+        usize::from(self.0[slot]).max(1)
+    }
+}
+
+/// Collects the fewest nearest points that stand for `k` samples, sorted by (squared
+/// distance, index), by insertion into fixed arrays (of `k + 1`, the point being inserted
+/// included). A candidate's key packs its index and storage slot ([`slot_key`]), so
 /// comparing keys compares indexes.
-struct KBest<'a> {
+struct KBest<'a, M> {
     px: f64,
     py: f64,
     k: usize,
+    /// Points held, and the samples they stand for.
     n: usize,
+    samples: usize,
+    counts: M,
     d2: &'a mut [f64],
     keys: &'a mut [u64],
-    /// The k-th best so far (infinite and `u64::MAX` until k are held).
+    /// The farthest point held once they stand for k samples (infinite and `u64::MAX`
+    /// before).
     worst: f64,
     worst_key: u64,
 }
 
-impl KBest<'_> {
-    /// Inserts a candidate that ranks before the current k-th best (dropping that one when
-    /// k are held), shifting the worse ones up one slot.
+impl<M: Multiplicity> KBest<'_, M> {
+    /// Samples of the point of `key`.
+    #[inline]
+    fn count(&self, key: u64) -> usize {
+        self.counts.of(split_key(key).1 as usize)
+    }
+
+    /// Inserts a candidate that ranks before the current farthest point (or any while
+    /// fewer than k samples are held), shifting the farther ones up one place, then drops
+    /// the farthest points the others make unnecessary.
     #[inline]
     fn insert(&mut self, d: f64, key: u64) {
-        let mut at = if self.n < self.k {
-            self.n += 1;
-            self.n - 1
-        } else {
-            self.k - 1
-        };
+        let mut at = self.n;
+        self.n += 1;
         while at > 0 {
             let (prev_d, prev_key) = (self.d2[at - 1], self.keys[at - 1]);
             if d < prev_d || (d == prev_d && key < prev_key) {
@@ -562,14 +655,23 @@ impl KBest<'_> {
         }
         self.d2[at] = d;
         self.keys[at] = key;
-        if self.n == self.k {
-            self.worst = self.d2[self.k - 1];
-            self.worst_key = self.keys[self.k - 1];
+        self.samples += self.count(key);
+        while self.n > 1 {
+            let last = self.count(self.keys[self.n - 1]);
+            if self.samples - last < self.k {
+                break;
+            }
+            self.samples -= last;
+            self.n -= 1;
+        }
+        if self.samples >= self.k {
+            self.worst = self.d2[self.n - 1];
+            self.worst_key = self.keys[self.n - 1];
         }
     }
 }
 
-impl Visitor for KBest<'_> {
+impl<M: Multiplicity> Visitor for KBest<'_, M> {
     #[inline]
     fn visit(&mut self, first_slot: usize, xs: &[f64], ys: &[f64], ids: &[u32]) {
         for (slot, ((&x, &y), &id)) in (first_slot..).zip(xs.iter().zip(ys).zip(ids)) {
@@ -608,8 +710,9 @@ impl NeighbourIndex for PointIndex {
 
     fn k_nearest(&self, p: Point2, k: usize, out: &mut Vec<Neighbour>) {
         out.clear();
-        with_scratch(k.min(self.xs.len()), |d2, ids| {
-            let n = self.k_nearest_into(p, d2, ids);
+        let k = k.min(self.xs.len());
+        with_scratch(k + 1, |d2, ids| {
+            let (n, _) = self.k_nearest_into(p, k, Single, d2, ids);
             out.extend(
                 ids[..n]
                     .iter()

@@ -63,6 +63,46 @@ fn check_same(points: &[Point2], queries: &[Point2], k: usize) {
         let finite = points.iter().filter(|p| p.is_finite()).count();
         assert_eq!(row.len(), if q.is_finite() { k.min(finite) } else { 0 });
     }
+    check_counted(points, queries, k);
+}
+
+/// The counted k-nearest against the brute-force order of the points: each point stands for
+/// 1 to 3 samples; the fewest nearest points holding k samples, and how many of the last
+/// one's samples are taken.
+fn check_counted(points: &[Point2], queries: &[Point2], k: usize) {
+    let count = |i: usize| 1 + u8::from(i.is_multiple_of(3)) + u8::from(i.is_multiple_of(7));
+    let mut grid = PointIndex::with_occupancy(2.0);
+    grid.rebuild(points);
+    let counts: Vec<u8> = grid
+        .slot_indexes()
+        .iter()
+        .map(|&i| count(i as usize))
+        .collect();
+    let slot_indexes = grid.slot_indexes().to_vec();
+    let mut got: Vec<(Vec<usize>, usize)> = Vec::new();
+    grid.map_k_nearest_counted(queries, k, &counts, &mut got, |slots, last_taken| {
+        let ids = slots
+            .iter()
+            .map(|&s| slot_indexes[s as usize] as usize)
+            .collect();
+        (ids, last_taken)
+    });
+    let brute = BruteForceIndex::new(points);
+    let mut order = Vec::new();
+    for (q, got) in queries.iter().zip(&got) {
+        brute.k_nearest(*q, points.len(), &mut order);
+        let (mut ids, mut samples, mut last_taken) = (Vec::new(), 0, 0);
+        for &(i, _) in &order {
+            if samples >= k {
+                break;
+            }
+            let c = usize::from(count(i));
+            last_taken = c.min(k - samples);
+            samples += c;
+            ids.push(i);
+        }
+        assert_eq!(*got, (ids, last_taken), "query {q:?}, k {k}");
+    }
 }
 
 proptest! {

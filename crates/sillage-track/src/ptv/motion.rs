@@ -32,7 +32,7 @@ impl Samples {
     }
 }
 
-/// One sample as the model averages it, laid out in the index's storage order.
+/// One sample as the model averages it.
 #[derive(Debug, Clone, Copy, Default)]
 struct Weighted {
     weight: f64,
@@ -40,16 +40,27 @@ struct Weighted {
     log_err: f64,
 }
 
+/// The samples at one indexed position, in the order the k-nearest of `recent ++ stored`
+/// meets them: the recent one first (lower index), then the stored one.
+#[derive(Debug, Clone, Copy, Default)]
+struct Copies {
+    samples: [Weighted; 2],
+    count: u8,
+}
+
 /// Evaluates the motion model at query points, reusing its index and buffers.
 #[derive(Debug, Clone)]
 pub(crate) struct MotionField {
     k: usize,
     stored_weight: f64,
-    /// Index over `recent ++ stored` positions, rebuilt at every evaluation.
+    /// Index over the samples' positions, rebuilt at every evaluation.
     index: PointIndex,
     /// The samples in the index's storage order, so that a query's neighbours are read
-    /// from a few contiguous runs rather than at random.
-    by_slot: Vec<Weighted>,
+    /// from a few contiguous runs rather than at random, and their counts.
+    by_slot: Vec<Copies>,
+    counts: Vec<u8>,
+    /// Per stored sample: the recent sample at the same position, if any.
+    partners: Vec<Option<usize>>,
     /// Per query: the weighted mean velocity and log error (NaN when weightless).
     means: Vec<(Vec2, f64)>,
 }
@@ -60,10 +71,13 @@ impl MotionField {
         Self {
             k,
             stored_weight,
-            // About k/5 points per cell: measured fastest for k = 10 among 2, 3.3 and 5
-            // (`cargo bench -p sillage-assoc --bench neighbours -- occupancy`).
-            index: PointIndex::with_occupancy((k as f64 / 5.0).max(1.0)),
+            // About k/8 positions per cell: in steady state the k samples come from ~k/2
+            // positions (most hold two); k/8 stepped faster than k/5 (BENCHMARKS.md, "The
+            // linking step").
+            index: PointIndex::with_occupancy((k as f64 / 8.0).max(1.0)),
             by_slot: Vec::new(),
+            counts: Vec::new(),
+            partners: Vec::new(),
             means: Vec::new(),
         }
     }
@@ -74,9 +88,13 @@ impl MotionField {
     /// `Propagate_MotionModel_KdTree`. Queries whose neighbours weigh nothing get u = 0,
     /// e = 2; the others become the model to store, written to `next`.
     ///
-    /// The two sample sets are indexed together in place (no copy), `recent` first, so the
-    /// neighbours and their summation order (nearest first, ties to `recent` and then to
-    /// the lower index) are exactly those of a k-d tree query over the concatenation.
+    /// The neighbours and their summation order (nearest first, ties to `recent` and then
+    /// to the lower index) are those of a k-d tree query over the concatenation. In steady
+    /// state every recent sample sits exactly on a stored one (both are points of the same
+    /// frame, in the same order): the stored positions alone are then indexed, each standing
+    /// for one or two samples, which halves the index and the neighbours to find. There, two
+    /// different points at exactly the same distance from a query give their samples point
+    /// by point rather than recent ones first.
     ///
     /// Eq. (8) as printed lost its bars; it reads
     /// v̄ᵢ(t) = 1/min(k, N̂) Σⱼ [α v̂ᵢⱼ(t−1) + (1−α) v̄ᵢⱼ(t−1)]: a mix of tracklet velocities
@@ -91,43 +109,77 @@ impl MotionField {
         e: &mut Vec<f64>,
         next: &mut Samples,
     ) {
-        self.index.rebuild_concat(&recent.pos, &stored.pos);
-        let n_recent = recent.len();
+        let recent_sample = |i: usize| Weighted {
+            weight: 1.0,
+            vel: recent.vel[i],
+            log_err: recent.log_err[i],
+        };
+        let stored_sample = |i: usize| Weighted {
+            weight: self.stored_weight,
+            vel: stored.vel[i],
+            log_err: stored.log_err[i],
+        };
+        let single = |sample| Copies {
+            samples: [sample, Weighted::default()],
+            count: 1,
+        };
         self.by_slot.clear();
-        self.by_slot
-            .extend(self.index.slot_indexes().iter().map(|&i| {
-                let i = i as usize;
-                if i < n_recent {
-                    Weighted {
-                        weight: 1.0,
-                        vel: recent.vel[i],
-                        log_err: recent.log_err[i],
+        if pair_with_stored(recent, stored, &mut self.partners) {
+            self.index.rebuild(&stored.pos);
+            let partners = &self.partners;
+            self.by_slot
+                .extend(self.index.slot_indexes().iter().map(|&i| {
+                    let i = i as usize;
+                    match partners[i] {
+                        Some(r) => Copies {
+                            samples: [recent_sample(r), stored_sample(i)],
+                            count: 2,
+                        },
+                        None => single(stored_sample(i)),
                     }
-                } else {
-                    let j = i - n_recent;
-                    Weighted {
-                        weight: self.stored_weight,
-                        vel: stored.vel[j],
-                        log_err: stored.log_err[j],
-                    }
-                }
-            }));
-        let by_slot = &self.by_slot;
-        self.index
-            .map_k_nearest(queries, self.k, &mut self.means, |_, slots| {
-                let (mut w_sum, mut v_sum, mut e_sum) = (0.0, Vec2::ZERO, 0.0);
-                for &slot in slots {
-                    let s = by_slot[slot as usize];
-                    w_sum += s.weight;
-                    v_sum = v_sum + s.vel * s.weight;
-                    e_sum += s.log_err * s.weight;
-                }
-                if w_sum > 0.0 {
-                    (v_sum / w_sum, e_sum / w_sum)
-                } else {
-                    (Vec2::new(f64::NAN, f64::NAN), f64::NAN)
-                }
-            });
+                }));
+            self.counts.clear();
+            self.counts.extend(self.by_slot.iter().map(|c| c.count));
+            let by_slot = &self.by_slot;
+            self.index.map_k_nearest_counted(
+                queries,
+                self.k,
+                &self.counts,
+                &mut self.means,
+                |slots, last_taken| {
+                    let (last, before) = slots
+                        .split_last()
+                        .map_or((None, slots), |(l, b)| (Some(l), b));
+                    let all = before
+                        .iter()
+                        .flat_map(|&s| {
+                            let c = &by_slot[s as usize];
+                            &c.samples[..usize::from(c.count)]
+                        })
+                        .chain(
+                            last.map_or(&[][..], |&s| &by_slot[s as usize].samples[..last_taken]),
+                        );
+                    weighted_mean(all)
+                },
+            );
+        } else {
+            self.index.rebuild_concat(&recent.pos, &stored.pos);
+            let n_recent = recent.len();
+            self.by_slot
+                .extend(self.index.slot_indexes().iter().map(|&i| {
+                    let i = i as usize;
+                    single(if i < n_recent {
+                        recent_sample(i)
+                    } else {
+                        stored_sample(i - n_recent)
+                    })
+                }));
+            let by_slot = &self.by_slot;
+            self.index
+                .map_k_nearest(queries, self.k, &mut self.means, |_, slots| {
+                    weighted_mean(slots.iter().map(|&s| &by_slot[s as usize].samples[0]))
+                });
+        }
         u.clear();
         e.clear();
         next.clear();
@@ -144,9 +196,101 @@ impl MotionField {
     }
 }
 
+/// Weighted means of the samples' velocities and log errors, summed in the order given;
+/// NaN when they weigh nothing.
+fn weighted_mean<'a>(samples: impl Iterator<Item = &'a Weighted>) -> (Vec2, f64) {
+    let (mut w_sum, mut v_sum, mut e_sum) = (0.0, Vec2::ZERO, 0.0);
+    for s in samples {
+        w_sum += s.weight;
+        v_sum = v_sum + s.vel * s.weight;
+        e_sum += s.log_err * s.weight;
+    }
+    if w_sum > 0.0 {
+        (v_sum / w_sum, e_sum / w_sum)
+    } else {
+        (Vec2::new(f64::NAN, f64::NAN), f64::NAN)
+    }
+}
+
+/// Pairs each recent sample with the stored sample at exactly the same position, walking
+/// both sets in order (`partners[j]` is the recent partner of stored sample `j`); true when
+/// every recent sample found one, as when both sets are points of the same frame in the same
+/// order (the tracker's steady state).
+fn pair_with_stored(recent: &Samples, stored: &Samples, partners: &mut Vec<Option<usize>>) -> bool {
+    partners.clear();
+    let mut next = 0;
+    for &p in &stored.pos {
+        if next < recent.len() && recent.pos[next] == p {
+            partners.push(Some(next));
+            next += 1;
+        } else {
+            partners.push(None);
+        }
+    }
+    next == recent.len()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::RngExt;
+    use sillage_core::rng_stream;
+
+    /// The model by brute force: the k nearest of `recent ++ stored` sorted by (distance,
+    /// index), summed in that order.
+    fn brute_force(q: Point2, k: usize, recent: &Samples, stored: &Samples, w: f64) -> (Vec2, f64) {
+        let mut all: Vec<(f64, usize, Weighted)> = Vec::new();
+        for (i, set, weight) in [(0, recent, 1.0), (recent.len(), stored, w)] {
+            for j in 0..set.len() {
+                let d = set.pos[j] - q;
+                let sample = Weighted {
+                    weight,
+                    vel: set.vel[j],
+                    log_err: set.log_err[j],
+                };
+                all.push((d.x * d.x + d.y * d.y, i + j, sample));
+            }
+        }
+        all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        weighted_mean(all.iter().take(k).map(|(_, _, s)| s))
+    }
+
+    #[test]
+    fn steady_state_samples_give_the_union_model_exactly() {
+        // Stored: every point of a frame; recent: two thirds of them, same positions, same
+        // order (the tracker's steady state), then the same sets with one recent sample moved
+        // (the general path).
+        let mut rng = rng_stream(5, 0);
+        let mut stored = Samples::default();
+        let mut recent = Samples::default();
+        for i in 0..400u32 {
+            let p = Point2::new(rng.random::<f64>() * 100.0, rng.random::<f64>() * 100.0);
+            let v = Vec2::new(rng.random::<f64>(), rng.random::<f64>());
+            stored.push(p, v, rng.random::<f64>() - 1.0);
+            if !i.is_multiple_of(3) {
+                recent.push(p, v * 1.1, rng.random::<f64>() - 2.0);
+            }
+        }
+        let queries: Vec<Point2> = (0..200)
+            .map(|_| {
+                Point2::new(
+                    rng.random::<f64>() * 110.0 - 5.0,
+                    rng.random::<f64>() * 110.0 - 5.0,
+                )
+            })
+            .collect();
+        let mut moved = recent.clone();
+        moved.pos[7].x += 0.25;
+        for (recent, k, w) in [(&recent, 10, 1.0), (&recent, 7, 0.5), (&moved, 10, 1.0)] {
+            let mut field = MotionField::new(k, w);
+            let (mut u, mut e, mut next) = (Vec::new(), Vec::new(), Samples::default());
+            field.evaluate(&queries, recent, &stored, &mut u, &mut e, &mut next);
+            for (i, &q) in queries.iter().enumerate() {
+                let (bu, be) = brute_force(q, k, recent, &stored, w);
+                assert_eq!((u[i], e[i]), (bu, be), "query {i}, k {k}");
+            }
+        }
+    }
 
     #[test]
     fn weighted_mean_of_nearest_samples() {
