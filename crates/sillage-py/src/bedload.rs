@@ -2,12 +2,12 @@
 
 use std::collections::BTreeMap;
 
-use numpy::PyReadonlyArray1;
 use numpy::ndarray::ArrayView1;
+use numpy::{IntoPyArray, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sillage::bedload::{BeadFrame, track_beads};
-use sillage::core::{Detection, Error, FrameIndex, Point2, Result};
+use sillage::core::{Detection, Error, FrameIndex, Point2, Result, TrackPoint};
 use sillage::toml_config::set_key;
 use sillage::track::bedload::BedloadTrackerParams;
 
@@ -67,11 +67,21 @@ pub fn track_bedload<'py>(
         })
         .map_err(to_py)?;
     let columns = track_columns(py, &points)?;
+    add_state_and_class(&columns, &points)?;
+    Ok(columns)
+}
+
+/// Adds to `columns` the columns `state` (motion-state names) and `class` of `points`: shared
+/// by tracked beads and the synthetic bedload truth.
+pub(crate) fn add_state_and_class(
+    columns: &Bound<'_, PyDict>,
+    points: &[TrackPoint],
+) -> PyResult<()> {
     let states: Vec<&str> = points.iter().map(|p| p.motion_state.name()).collect();
     let classes: Vec<i64> = points.iter().map(|p| i64::from(p.class)).collect();
     columns.set_item("state", states)?;
-    columns.set_item("class", numpy::IntoPyArray::into_pyarray(classes, py))?;
-    Ok(columns)
+    columns.set_item("class", classes.into_pyarray(columns.py()))?;
+    Ok(())
 }
 
 /// Read-only views of one table's columns.

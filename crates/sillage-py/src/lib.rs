@@ -217,6 +217,7 @@ fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(ptv, module)?)?;
     module.add_function(wrap_pyfunction!(link, module)?)?;
     module.add_function(wrap_pyfunction!(synth::synth_vortex, module)?)?;
+    module.add_function(wrap_pyfunction!(synth::synth_bedload, module)?)?;
     module.add_class::<stream::PtvStream>()?;
     module.add_function(wrap_pyfunction!(eval::evaluate, module)?)?;
     module.add_function(wrap_pyfunction!(bedload::track_bedload, module)?)?;

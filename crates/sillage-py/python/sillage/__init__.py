@@ -42,7 +42,8 @@ from . import _sillage
 
 __version__ = _sillage.__version__
 
-__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "track_bedload", "evaluate", "synth_vortex", "config_keys"]
+__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "track_bedload", "evaluate", "synth_vortex",
+           "synth_bedload", "config_keys"]
 
 #: Column order of detections (trackpy's ``locate`` puts ``y`` before ``x``).
 _DETECTION_COLUMNS = ["y", "x", "signal", "frame"]
@@ -271,6 +272,45 @@ def synth_vortex(**params: Any) -> tuple[np.ndarray, pd.DataFrame]:
         _assign(name, value, assignments)
     frames, truth = _sillage.synth_vortex(assignments)
     return frames, pd.DataFrame(truth)
+
+
+def synth_bedload(*, detection: Mapping[str, Any] | None = None,
+                  **scene: Any) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """Generates a synthetic bedload sequence (glass beads in a channel, MMPF+ §4.2): the true
+    beads, with motion states, and what a bead detector reports of them.
+
+    Keywords are the scene's keys: ``n_frames`` (default 200), ``n_black`` (black beads,
+    bed included, 300), ``n_transparent`` (100), ``width``, ``height`` (1280 × 320 px),
+    ``seed`` (0), ``transition_probabilities``...; ``detection`` holds the detector model's:
+    ``position_sigma_px`` (0.5), ``transparent_miss_probability`` (0.03),
+    ``burst_probability`` (0.01), ``false_positive_mean`` (1.0)... (the fields of the Rust
+    ``BedloadSceneParams`` and ``BedloadDetectionParams`` document them all; list values are
+    lists). Returns three DataFrames:
+
+    * ``truth``: one row per bead and frame with ``frame``, ``particle``, ``x``, ``y`` (px),
+      ``vx``, ``vy`` (the displacement *from the previous* frame, NaN in a bead's first),
+      ``state`` (``resting``, ``rolling``, ``saltating``) and ``class`` (0 black,
+      1 transparent): the truth :func:`evaluate` takes;
+    * ``detections``: ``frame``, ``x``, ``y``, ``class``, ``score``, with misses, noise and
+      false positives;
+    * ``candidates``: the same columns, the detector-confidence candidates of Eq. (1)
+      (transparent beads only),
+
+    as :func:`track_bedload` reads them.
+
+    >>> truth, detections, candidates = sillage.synth_bedload(n_frames=50, seed=1,
+    ...                                                       detection={"position_sigma_px": 1.0})
+    >>> beads = sillage.track_bedload(detections, candidates=candidates, seed=1)
+    >>> sillage.evaluate(truth, beads, match_px=5.0)["clear"]["mota"]
+    """
+    scene_overrides: list[str] = []
+    for name, value in scene.items():
+        _assign(name, value, scene_overrides)
+    detection_overrides: list[str] = []
+    for name, value in (detection or {}).items():
+        _assign(name, value, detection_overrides)
+    truth, detections, candidates = _sillage.synth_bedload(scene_overrides, detection_overrides)
+    return pd.DataFrame(truth), pd.DataFrame(detections), pd.DataFrame(candidates)
 
 
 def _frames_argument(frames: Any) -> Any:
