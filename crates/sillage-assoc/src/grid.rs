@@ -425,7 +425,7 @@ impl PointIndex {
     }
 
     /// [`PointIndex::map_k_nearest`] over points that each stand for several samples at the
-    /// same place (`counts_by_slot[slot]` ≥ 1 samples, in storage order): for every query,
+    /// same place (`counts_by_slot[slot]` samples, in storage order; 0 counts as 1): for every query,
     /// `f(slots, last_taken)` of the fewest nearest points whose samples reach `k` (all points
     /// when they hold fewer), nearest first, ties to the lower index. The last point gives
     /// only `last_taken` of its samples when the k-th sample falls inside it.
@@ -450,6 +450,8 @@ impl PointIndex {
             "one count per indexed point"
         );
         let counts = BySlot(counts_by_slot);
+        let all_samples = (0..self.xs.len()).map(|slot| counts.of(slot)).sum();
+        let k = k.min(all_samples);
         self.map_nearest_samples(queries, k, counts, out, |_, slots, samples| {
             let last_taken = slots.last().map_or(0, |&slot| {
                 let count = counts.of(slot as usize);
