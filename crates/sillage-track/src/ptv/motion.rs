@@ -40,13 +40,10 @@ struct Weighted {
     log_err: f64,
 }
 
-/// The samples at one indexed position, in the order the k-nearest of `recent ++ stored`
-/// meets them: the recent one first (lower index), then the stored one.
-#[derive(Debug, Clone, Copy, Default)]
-struct Copies {
-    samples: [Weighted; 2],
-    count: u8,
-}
+/// The samples at one indexed position (one or two, [`MotionField`]'s `counts`), in the
+/// order the k-nearest of `recent ++ stored` meets them: the recent one first (lower index),
+/// then the stored one.
+type Copies = [Weighted; 2];
 
 /// Evaluates the motion model at query points, reusing its index and buffers.
 #[derive(Debug, Clone)]
@@ -56,7 +53,7 @@ pub(crate) struct MotionField {
     /// Index over the samples' positions, rebuilt at every evaluation.
     index: PointIndex,
     /// The samples in the index's storage order, so that a query's neighbours are read
-    /// from a few contiguous runs rather than at random, and their counts.
+    /// from a few contiguous runs rather than at random, and how many each slot holds.
     by_slot: Vec<Copies>,
     counts: Vec<u8>,
     /// Per stored sample: the recent sample at the same position, if any.
@@ -119,32 +116,24 @@ impl MotionField {
             vel: stored.vel[i],
             log_err: stored.log_err[i],
         };
-        let single = |sample| Copies {
-            samples: [sample, Weighted::default()],
-            count: 1,
-        };
         self.by_slot.clear();
         if pair_with_stored(recent, stored, &mut self.partners) {
             self.index.rebuild(&stored.pos);
-            let partners = &self.partners;
-            self.by_slot
-                .extend(self.index.slot_indexes().iter().map(|&i| {
-                    let i = i as usize;
-                    match partners[i] {
-                        Some(r) => Copies {
-                            samples: [recent_sample(r), stored_sample(i)],
-                            count: 2,
-                        },
-                        None => single(stored_sample(i)),
-                    }
-                }));
             self.counts.clear();
-            self.counts.extend(self.by_slot.iter().map(|c| c.count));
-            let by_slot = &self.by_slot;
+            for &i in self.index.slot_indexes() {
+                let i = i as usize;
+                let (copies, count) = match self.partners[i] {
+                    Some(r) => ([recent_sample(r), stored_sample(i)], 2),
+                    None => ([stored_sample(i), Weighted::default()], 1),
+                };
+                self.by_slot.push(copies);
+                self.counts.push(count);
+            }
+            let (by_slot, counts) = (&self.by_slot, &self.counts);
             self.index.map_k_nearest_counted(
                 queries,
                 self.k,
-                &self.counts,
+                counts,
                 &mut self.means,
                 |slots, last_taken| {
                     let (last, before) = slots
@@ -152,13 +141,8 @@ impl MotionField {
                         .map_or((None, slots), |(l, b)| (Some(l), b));
                     let all = before
                         .iter()
-                        .flat_map(|&s| {
-                            let c = &by_slot[s as usize];
-                            &c.samples[..usize::from(c.count)]
-                        })
-                        .chain(
-                            last.map_or(&[][..], |&s| &by_slot[s as usize].samples[..last_taken]),
-                        );
+                        .flat_map(|&s| &by_slot[s as usize][..usize::from(counts[s as usize])])
+                        .chain(last.map_or(&[][..], |&s| &by_slot[s as usize][..last_taken]));
                     weighted_mean(all)
                 },
             );
@@ -168,16 +152,17 @@ impl MotionField {
             self.by_slot
                 .extend(self.index.slot_indexes().iter().map(|&i| {
                     let i = i as usize;
-                    single(if i < n_recent {
+                    let sample = if i < n_recent {
                         recent_sample(i)
                     } else {
                         stored_sample(i - n_recent)
-                    })
+                    };
+                    [sample, Weighted::default()]
                 }));
             let by_slot = &self.by_slot;
             self.index
                 .map_k_nearest(queries, self.k, &mut self.means, |_, slots| {
-                    weighted_mean(slots.iter().map(|&s| &by_slot[s as usize].samples[0]))
+                    weighted_mean(slots.iter().map(|&s| &by_slot[s as usize][0]))
                 });
         }
         u.clear();
