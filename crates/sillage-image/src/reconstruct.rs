@@ -7,8 +7,15 @@
 //! reconstruction in image analysis", IEEE TIP 2(2), 1993): one raster and one anti-raster
 //! scan propagate the marker along most paths, then a FIFO queue, seeded by the pixels the
 //! anti-raster scan could still lower, finishes the job; linear in the number of pixels. The
-//! result is the unique fixed point of the propagation (only `min`/`max` of input values), so
-//! it is exact and does not depend on any order.
+//! result is the greatest fixed point of the propagation below the marker (only `min`/`max`
+//! of input values), so it is exact and does not depend on any order.
+//!
+//! Parallel bands: the image is cut into one band of rows per thread, each band
+//! reconstructed on its own (its result is a fixed point inside the band and, since a band
+//! has fewer paths, at or above the whole image's reconstruction), then the queue, seeded
+//! with the rows on either side of each seam, propagates across the seams. Every value the
+//! propagation writes is justified by a neighbour, so it ends on the same greatest fixed
+//! point: the result does not depend on the number of threads.
 //!
 //! 8-bit levels ([`Reconstruction::h_concave_levels`]): the same algorithm on `u16` levels
 //! (the marker `f + h` may exceed 255), 32 lanes per AVX-512 vector instead of 16; since it
@@ -16,6 +23,7 @@
 
 use std::collections::VecDeque;
 
+use rayon::prelude::*;
 use sillage_core::{Error, GrayImage, Image, Result};
 
 use crate::mask::check_same_size;
@@ -117,17 +125,24 @@ fn scans_avx512bw(r: &mut [u16], m: &[u16], width: usize, queue: &mut VecDeque<u
     scans::<u16, true>(r, m, width, queue);
 }
 
-/// Reconstruction and h-transforms with a reusable queue and level buffers.
+/// The fewest rows a parallel band gets: thinner bands would spend more on their seams
+/// than they save.
+const MIN_BAND_ROWS: usize = 32;
+
+/// Pixels per parallel task of the element-wise passes.
+const PAR_CHUNK: usize = 1 << 15;
+
+/// Reconstruction and h-transforms with reusable queues (one per band) and level buffers.
 #[derive(Debug, Clone, Default)]
 pub struct Reconstruction {
-    queue: VecDeque<usize>,
+    queues: Vec<VecDeque<usize>>,
     /// The marker and the mask of the levels path.
     marker_levels: Vec<u16>,
     mask_levels: Vec<u16>,
 }
 
 impl Reconstruction {
-    /// An engine with an empty queue.
+    /// An engine with empty queues.
     pub fn new() -> Self {
         Self::default()
     }
@@ -154,7 +169,7 @@ impl Reconstruction {
             marker.as_mut_slice(),
             mask.as_slice(),
             mask.width(),
-            &mut self.queue,
+            &mut self.queues,
         );
         Ok(())
     }
@@ -176,7 +191,7 @@ impl Reconstruction {
         for (d, &s) in dst.as_mut_slice().iter_mut().zip(src.as_slice()) {
             *d = s + h;
         }
-        reconstruct(dst.as_mut_slice(), src.as_slice(), width, &mut self.queue);
+        reconstruct(dst.as_mut_slice(), src.as_slice(), width, &mut self.queues);
         for (d, &s) in dst.as_mut_slice().iter_mut().zip(src.as_slice()) {
             *d -= s;
         }
@@ -191,38 +206,83 @@ impl Reconstruction {
         let (width, height) = src.dimensions();
         dst.reshape(width, height);
         let src = src.as_slice();
-        self.mask_levels.clear();
-        self.mask_levels.extend(src.iter().map(|&f| u16::from(f)));
-        self.marker_levels.clear();
-        self.marker_levels
-            .extend(src.iter().map(|&f| u16::from(f) + u16::from(h)));
+        self.mask_levels.resize(src.len(), 0);
+        self.marker_levels.resize(src.len(), 0);
+        self.mask_levels
+            .par_chunks_mut(PAR_CHUNK)
+            .zip(self.marker_levels.par_chunks_mut(PAR_CHUNK))
+            .zip(src.par_chunks(PAR_CHUNK))
+            .for_each(|((mask, marker), src)| {
+                for ((m, r), &f) in mask.iter_mut().zip(marker.iter_mut()).zip(src) {
+                    *m = u16::from(f);
+                    *r = u16::from(f) + u16::from(h);
+                }
+            });
         reconstruct(
             &mut self.marker_levels,
             &self.mask_levels,
             width,
-            &mut self.queue,
+            &mut self.queues,
         );
-        for ((d, &r), &f) in dst
-            .as_mut_slice()
-            .iter_mut()
-            .zip(&self.marker_levels)
-            .zip(src)
-        {
-            // r − f ≤ h ≤ 255.
-            *d = (r - u16::from(f)) as u8;
-        }
+        dst.as_mut_slice()
+            .par_chunks_mut(PAR_CHUNK)
+            .zip(self.marker_levels.par_chunks(PAR_CHUNK))
+            .zip(src.par_chunks(PAR_CHUNK))
+            .for_each(|((dst, marker), src)| {
+                for ((d, &r), &f) in dst.iter_mut().zip(marker).zip(src) {
+                    // r − f ≤ h ≤ 255.
+                    *d = (r - u16::from(f)) as u8;
+                }
+            });
     }
 }
 
-/// The hybrid algorithm on a marker `r` known to be ≥ the mask `m` (rows of `width`).
-fn reconstruct<T: Level>(r: &mut [T], m: &[T], width: usize, queue: &mut VecDeque<usize>) {
+/// The hybrid algorithm on a marker `r` known to be ≥ the mask `m` (rows of `width`), in
+/// parallel bands of rows (one per thread, at least [`MIN_BAND_ROWS`] rows each) joined by
+/// a propagation across their seams.
+fn reconstruct<T: Level>(r: &mut [T], m: &[T], width: usize, queues: &mut Vec<VecDeque<usize>>) {
     if width == 0 || m.is_empty() {
         return;
     }
     let height = m.len() / width;
-    queue.clear();
-    T::scans_dispatch(r, m, width, queue);
-    // Propagation.
+    let bands = rayon::current_num_threads()
+        .min(height / MIN_BAND_ROWS)
+        .max(1);
+    reconstruct_in_bands(r, m, width, bands, queues);
+}
+
+/// [`reconstruct`] with `bands` bands of rows (the result does not depend on it).
+fn reconstruct_in_bands<T: Level>(
+    r: &mut [T],
+    m: &[T],
+    width: usize,
+    bands: usize,
+    queues: &mut Vec<VecDeque<usize>>,
+) {
+    let height = m.len() / width;
+    let band_rows = height.div_ceil(bands);
+    queues.resize_with(bands.max(1), VecDeque::new);
+    r.par_chunks_mut(band_rows * width)
+        .zip(m.par_chunks(band_rows * width))
+        .zip(queues.par_iter_mut())
+        .for_each(|((r, m), queue)| {
+            queue.clear();
+            T::scans_dispatch(r, m, width, queue);
+            propagate(r, m, width, queue);
+        });
+    // The seams: the last row of a band and the first of the next may lower each other.
+    let queue = &mut queues[0];
+    for seam in (band_rows..height).step_by(band_rows) {
+        queue.extend((seam - 1) * width..(seam + 1) * width);
+    }
+    propagate(r, m, width, queue);
+}
+
+/// Vincent's FIFO propagation: each queued pixel lowers the 8 neighbours above it and above
+/// their mask to its own value (or their mask), queueing them in turn, until the queue is
+/// empty.
+fn propagate<T: Level>(r: &mut [T], m: &[T], width: usize, queue: &mut VecDeque<usize>) {
+    let height = m.len() / width;
     let neighbour = |p: usize, (dx, dy): (isize, isize)| {
         let (x, y) = ((p % width) as isize + dx, (p / width) as isize + dy);
         (x >= 0 && y >= 0 && (x as usize) < width && (y as usize) < height)

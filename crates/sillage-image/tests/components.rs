@@ -54,7 +54,15 @@ fn reference(mask: &Image<bool>) -> Vec<Component> {
 fn matches_flood_fill_on_random_masks() {
     let mut labeller = ComponentLabeller::new();
     let mut state = 99u64;
-    for (w, h, density) in [(1, 1, 50), (30, 20, 35), (64, 64, 55), (200, 3, 60)] {
+    for (w, h, density) in [
+        (1, 1, 50),
+        (30, 20, 35),
+        (64, 64, 55),
+        (200, 3, 60),
+        (129, 6, 95),
+        (70, 9, 5),
+        (128, 2, 100),
+    ] {
         let data = (0..w * h)
             .map(|_| {
                 state = state

@@ -71,6 +71,47 @@ fn reconstruction_matches_iterated_geodesic_erosion() {
     }
 }
 
+/// Images tall enough to be cut into parallel bands (32 rows or more each) give the same
+/// reconstruction with 1 to 4 threads: the spiral wall and the waves carry the marker across
+/// the seams both ways.
+#[test]
+fn reconstruction_does_not_depend_on_the_thread_count() {
+    let (w, h) = (60, 140);
+    let mask = landscape(w, h, 21);
+    let mut marker = mask.clone();
+    for (i, v) in marker.as_mut_slice().iter_mut().enumerate() {
+        *v += if i % 11 == 0 { 0.0 } else { 0.4 };
+    }
+    let expected = reference(&marker, &mask);
+    let levels = Image::from_vec(
+        w,
+        h,
+        mask.as_slice()
+            .iter()
+            .map(|&v| (v * 255.0).round().min(255.0) as u8)
+            .collect(),
+    )
+    .unwrap();
+    let mut single_thread_levels = None;
+    for threads in 1..=4 {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let (got, got_levels) = pool.install(|| {
+            let mut engine = Reconstruction::new();
+            let mut got = marker.clone();
+            engine.erode_reconstruct(&mut got, &mask).unwrap();
+            let mut got_levels = Image::default();
+            engine.h_concave_levels(&levels, 44, &mut got_levels);
+            (got, got_levels)
+        });
+        assert_eq!(got, expected, "{threads} threads");
+        let single = single_thread_levels.get_or_insert_with(|| got_levels.clone());
+        assert_eq!(&got_levels, single, "{threads} threads");
+    }
+}
+
 #[test]
 fn h_concave_is_basin_depth_clipped_at_h() {
     let mut engine = Reconstruction::new();
