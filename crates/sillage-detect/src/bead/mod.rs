@@ -8,7 +8,7 @@
 //! 2. **black beads** (module `black`): `f ≤ τ_b`, eroded by a disk of radius `⌈r_b/2⌉` so that
 //!    touching beads separate, 8-connected components with an area up to `π(⌈r_b/2⌉+1)²`,
 //!    their centroids (sub-pixel);
-//! 3. **erasing**: the background is the closing of the frame by a disk of radius
+//! 3. **erasing** (the closing runs beside step 2): the background is the closing of the frame by a disk of radius
 //!    `⌊1.5·r_b⌋`; the black top-hat `closing − f` is set to 0 on the base and on a disk of
 //!    radius `r_b` around each black bead (the frame replaced by its background there);
 //! 4. **transparent beads** (module `transparent`): h-concave transform of the top-hat (basins
@@ -192,7 +192,13 @@ impl BeadDetector {
                     *v |= u8::from(b).wrapping_neg();
                 }
             }
-            self.black.detect_levels(&self.levels, &mut out.black);
+            // The black beads and the background closing are independent: side by side.
+            let (black, transparent, levels) =
+                (&mut self.black, &mut self.transparent, &self.levels);
+            rayon::join(
+                || black.detect_levels(levels, &mut out.black),
+                || transparent.close_levels(levels),
+            );
             self.transparent.detect_levels(
                 frame,
                 &self.levels,
@@ -223,10 +229,14 @@ impl BeadDetector {
             }
             None => self.bright_base.clone_from(frame),
         }
-        self.black.detect(&self.bright_base, &mut out.black);
+        let (black, transparent, bright_base) =
+            (&mut self.black, &mut self.transparent, &self.bright_base);
+        rayon::join(
+            || black.detect(bright_base, &mut out.black),
+            || transparent.close(bright_base),
+        );
         self.transparent.detect(
             frame,
-            &self.bright_base,
             self.base.as_ref(),
             &out.black,
             TransparentOutput {

@@ -81,19 +81,23 @@ impl TransparentStage {
         self.correlator = RingCorrelator::new(template);
     }
 
-    /// Appends the transparent beads and candidates of `frame`. `bright_base` is the frame
-    /// with the base pixels set to 1 (so the closing does not see the base as dark), `base`
-    /// the base mask and `black` the black beads found in it.
+    /// The background of the `f32` path: the closing of `bright_base` (the frame with the
+    /// base pixels set to 1, so that the closing does not see the base as dark). Independent
+    /// of the black beads, so it can run beside the black stage.
+    pub(crate) fn close(&mut self, bright_base: &GrayImage) {
+        self.morphology
+            .close(bright_base, &self.background, &mut self.closed);
+    }
+
+    /// Appends the transparent beads and candidates of `frame`, after [`Self::close`] on
+    /// `bright_base`; `base` is the base mask and `black` the black beads found in it.
     pub(crate) fn detect(
         &mut self,
         frame: &GrayImage,
-        bright_base: &GrayImage,
         base: Option<&Image<bool>>,
         black: &[Detection],
         out: TransparentOutput<'_>,
     ) -> Result<()> {
-        self.morphology
-            .close(bright_base, &self.background, &mut self.closed);
         erased_top_hat(
             &self.closed,
             frame,
@@ -109,10 +113,16 @@ impl TransparentStage {
         Ok(())
     }
 
-    /// [`TransparentStage::detect`] on the 8-bit levels of the bright-base frame, with `h`
-    /// as a level: closing, top-hat and h-concave transform exactly on levels, the
-    /// correlation with exact integer sums (the `f32` path rounds `closing − f`, `+ h` and
-    /// its correlation sums, within `f32` rounding of these values).
+    /// [`Self::close`] on the 8-bit levels of the bright-base frame.
+    pub(crate) fn close_levels(&mut self, bright_base: &Image<u8>) {
+        self.morphology
+            .close_levels(bright_base, &self.background, &mut self.closed_levels);
+    }
+
+    /// [`Self::detect`] on the 8-bit levels of the bright-base frame, after
+    /// [`Self::close_levels`] on them, with `h` as a level: top-hat and h-concave transform
+    /// exactly on levels, the correlation with exact integer sums (the `f32` path rounds
+    /// `closing − f`, `+ h` and its correlation sums, within `f32` rounding of these values).
     pub(crate) fn detect_levels(
         &mut self,
         frame: &GrayImage,
@@ -122,8 +132,6 @@ impl TransparentStage {
         black: &[Detection],
         out: TransparentOutput<'_>,
     ) {
-        self.morphology
-            .close_levels(bright_base, &self.background, &mut self.closed_levels);
         erased_top_hat(
             &self.closed_levels,
             bright_base,
