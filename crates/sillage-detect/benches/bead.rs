@@ -8,8 +8,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use sillage_core::{GrayImage, Image};
 use sillage_detect::{BeadDetections, BeadDetector, BeadParams};
 use sillage_image::{
-    Morphology, PeakFinder, Reconstruction, RingCorrelator, RingTemplate, StructuringElement,
-    box_mean_3x3, encode_levels,
+    BoxMean, Morphology, PeakFinder, Reconstruction, RingCorrelator, RingTemplate,
+    StructuringElement, box_mean_3x3, encode_levels,
 };
 use sillage_io::read_image;
 
@@ -85,6 +85,10 @@ fn bench_bead(c: &mut Criterion) {
             box_mean_3x3(black_box(&correlation), &mut a);
             box_mean_3x3(&a, &mut t);
         })
+    });
+    let mut smoothing = BoxMean::new();
+    group.bench_function("mean3x3_twice_fused", |b| {
+        b.iter(|| smoothing.apply(black_box(&correlation), 2, &mut t))
     });
     // The levels path of 8-bit frames (what the detector runs on the real frames).
     let (mut levels, mut out) = (Image::default(), Image::default());

@@ -68,7 +68,7 @@ pub mod subpixel;
 
 pub use background::BackgroundModel;
 pub use bandpass::{DogFilter, LogFilter, MAX_SCALE_PX, Polarity};
-pub use box_mean::box_mean_3x3;
+pub use box_mean::{BoxMean, box_mean_3x3};
 pub use components::{Component, ComponentLabeller, PixelBox};
 pub use dominant_colours::{DominantColours, WeightedColour};
 pub use gaussian::{GaussianFilter, GaussianKernel, MAX_SIGMA_PX};

@@ -6,8 +6,8 @@
 
 use sillage_core::{Detection, GrayImage, Image, Point2, Result, TRANSPARENT_BEAD_CLASS};
 use sillage_image::{
-    Morphology, Peak, PeakFinder, Reconstruction, RingCorrelator, RingTemplate, StructuringElement,
-    box_mean_3x3,
+    BoxMean, Morphology, Peak, PeakFinder, Reconstruction, RingCorrelator, RingTemplate,
+    StructuringElement,
 };
 
 /// The thresholds and sizes of the transparent stage, all checked by
@@ -34,6 +34,7 @@ pub(crate) struct TransparentStage {
     morphology: Morphology,
     reconstruction: Reconstruction,
     correlator: RingCorrelator,
+    smoothing: BoxMean,
     finder: PeakFinder,
     closed: GrayImage,
     top_hat: GrayImage,
@@ -63,6 +64,7 @@ impl TransparentStage {
             morphology: Morphology::new(),
             reconstruction: Reconstruction::new(),
             correlator: RingCorrelator::new(template),
+            smoothing: BoxMean::new(),
             finder: PeakFinder::new(),
             closed: GrayImage::default(),
             top_hat: GrayImage::default(),
@@ -156,10 +158,9 @@ impl TransparentStage {
         out: TransparentOutput<'_>,
     ) {
         let s = self.settings;
-        for _ in 0..s.smoothing_passes {
-            box_mean_3x3(&self.correlation, &mut self.smoothed);
-            std::mem::swap(&mut self.correlation, &mut self.smoothed);
-        }
+        self.smoothing
+            .apply(&self.correlation, s.smoothing_passes, &mut self.smoothed);
+        std::mem::swap(&mut self.correlation, &mut self.smoothed);
         // PeakFinder keeps values strictly above its threshold; BeadTracking keeps `≥`, the
         // same maxima but for exact ties.
         self.finder
