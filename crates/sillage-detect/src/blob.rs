@@ -1,11 +1,10 @@
 //! Blob detection (TracTrac §3.1.1 and its `blob_detection` / `maximaThresh`): band-pass filter
 //! at scale δ, threshold, local maxima, sub-pixel fit (Eqs. (3)–(4)).
 
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sillage_core::{Detection, Detector, Error, GrayImage, Point2, Result};
 use sillage_image::{
-    DogFilter, LogFilter, MAX_SCALE_PX, Peak, PeakFinder, Polarity, Roi, SubpixelFit, mean_std,
+    DogFilter, LogFilter, MAX_SCALE_PX, PeakFinder, Polarity, Roi, SubpixelFit, mean_std,
     median_mad, refine_peak,
 };
 
@@ -199,8 +198,7 @@ pub struct BlobDetector {
     band_pass: BandPass,
     cropped: GrayImage,
     filtered: GrayImage,
-    finder: PeakFinder,
-    peaks: Vec<Peak>,
+    finder: PeakFinder<Detection>,
     samples: Vec<f32>,
     last_threshold: Option<f32>,
 }
@@ -219,8 +217,7 @@ impl BlobDetector {
             band_pass,
             cropped: GrayImage::default(),
             filtered: GrayImage::default(),
-            finder: PeakFinder::new(),
-            peaks: Vec::new(),
+            finder: PeakFinder::default(),
             samples: Vec::new(),
             last_threshold: None,
         })
@@ -283,25 +280,24 @@ impl Detector for BlobDetector {
         };
         self.last_threshold = Some(threshold);
         let filtered = &self.filtered;
-        self.finder.find(
+        let subpixel = self.params.subpixel;
+        // Peaks are at least one pixel inside the frame, so their 3×3 neighbourhood is too and
+        // the fit always has a result; the integer position is only a formal fallback. Each
+        // peak is fitted as soon as it is found, its rows still in cache, in peak order.
+        self.finder.find_map(
             filtered,
             self.params.neighbourhood,
             threshold,
-            &mut self.peaks,
+            |peak| {
+                let pos = refine_peak(filtered, peak.x, peak.y, subpixel)
+                    .unwrap_or(Point2::new(peak.x as f64, peak.y as f64));
+                Detection::new(
+                    Point2::new(pos.x + x0 as f64, pos.y + y0 as f64),
+                    filtered.get(peak.x, peak.y),
+                )
+            },
+            out,
         );
-        let subpixel = self.params.subpixel;
-        // Peaks are at least one pixel inside the frame, so their 3×3 neighbourhood is too and
-        // the fit always has a result; the integer position is only a formal fallback.
-        // Fits run in parallel straight into `out` (an indexed iterator: no allocation once
-        // `out` has grown), in peak order.
-        out.par_extend(self.peaks.par_iter().map(|peak| {
-            let pos = refine_peak(filtered, peak.x, peak.y, subpixel)
-                .unwrap_or(Point2::new(peak.x as f64, peak.y as f64));
-            Detection::new(
-                Point2::new(pos.x + x0 as f64, pos.y + y0 as f64),
-                filtered.get(peak.x, peak.y),
-            )
-        }));
         Ok(())
     }
 }

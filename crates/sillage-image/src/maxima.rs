@@ -17,10 +17,17 @@ pub struct Peak {
 }
 
 /// Finds local maxima; keeps per-band buffers so that repeated calls allocate nothing once
-/// the buffers have grown.
-#[derive(Debug, Clone, Default)]
-pub struct PeakFinder {
-    bands: Vec<Vec<Peak>>,
+/// the buffers have grown. `T` is what each peak becomes: the peak itself ([`Self::find`]) or
+/// what a caller makes of it while its rows are still in cache ([`Self::find_map`]).
+#[derive(Debug, Clone)]
+pub struct PeakFinder<T = Peak> {
+    bands: Vec<Vec<T>>,
+}
+
+impl<T> Default for PeakFinder<T> {
+    fn default() -> Self {
+        Self { bands: Vec::new() }
+    }
 }
 
 impl PeakFinder {
@@ -49,6 +56,23 @@ impl PeakFinder {
         threshold: f32,
         out: &mut Vec<Peak>,
     ) {
+        self.find_map(image, half_window, threshold, |peak| peak, out);
+    }
+}
+
+impl<T: Copy + Send> PeakFinder<T> {
+    /// [`PeakFinder::find`], each peak turned into `map(peak)` as soon as it is found, in the
+    /// band of rows being scanned: a map that reads the pixels around the peak (a sub-pixel
+    /// fit) finds them in cache instead of reading the image a second time. `out` (cleared
+    /// first) is in the peaks' raster order, whatever the number of threads.
+    pub fn find_map(
+        &mut self,
+        image: &GrayImage,
+        half_window: usize,
+        threshold: f32,
+        map: impl Fn(Peak) -> T + Sync,
+        out: &mut Vec<T>,
+    ) {
         out.clear();
         let (width, height) = image.dimensions();
         let n = half_window;
@@ -62,10 +86,13 @@ impl PeakFinder {
         self.bands[..bands]
             .par_iter_mut()
             .enumerate()
-            .for_each(|(band, peaks)| {
+            .for_each(|(band, found)| {
                 let y0 = n + band * BAND_ROWS;
                 let y1 = (y0 + BAND_ROWS).min(height - n);
-                scan_band_dispatch(image, y0..y1, n, threshold, peaks);
+                found.clear();
+                scan_band_dispatch(image, y0..y1, n, threshold, &mut |peak| {
+                    found.push(map(peak))
+                });
             });
         for band in &self.bands[..bands] {
             out.extend_from_slice(band);
@@ -83,17 +110,17 @@ fn scan_band_dispatch(
     ys: std::ops::Range<usize>,
     n: usize,
     threshold: f32,
-    peaks: &mut Vec<Peak>,
+    emit: &mut impl FnMut(Peak),
 ) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, checked just above.
-            unsafe { scan_band_avx2(image, ys, n, threshold, peaks) };
+            unsafe { scan_band_avx2(image, ys, n, threshold, emit) };
             return;
         }
     }
-    scan_band(image, ys, n, threshold, peaks);
+    scan_band(image, ys, n, threshold, emit);
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -103,22 +130,21 @@ fn scan_band_avx2(
     ys: std::ops::Range<usize>,
     n: usize,
     threshold: f32,
-    peaks: &mut Vec<Peak>,
+    emit: &mut impl FnMut(Peak),
 ) {
-    scan_band(image, ys, n, threshold, peaks);
+    scan_band(image, ys, n, threshold, emit);
 }
 
-/// Finds the peaks of rows `ys` into `peaks` (cleared first; see [`PeakFinder::find`]).
+/// Hands the peaks of rows `ys` to `emit`, in raster order (see [`PeakFinder::find`]).
 #[inline(always)]
 fn scan_band(
     image: &GrayImage,
     ys: std::ops::Range<usize>,
     n: usize,
     threshold: f32,
-    peaks: &mut Vec<Peak>,
+    emit: &mut impl FnMut(Peak),
 ) {
     let width = image.width();
-    peaks.clear();
     let (start, end) = (n, width - n);
     for y in ys {
         let row = image.row(y);
@@ -136,7 +162,7 @@ fn scan_band(
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if is_first_window_max(image, x + i, y, n, row[x + i]) {
-                    peaks.push(Peak { y, x: x + i });
+                    emit(Peak { y, x: x + i });
                 }
             }
             x += lanes;
