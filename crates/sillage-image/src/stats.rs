@@ -2,6 +2,7 @@
 //! deviation ([`mean_std`]), and a robust noise level, median and scaled MAD of a fixed
 //! subsample ([`median_mad`]).
 
+use rayon::prelude::*;
 use sillage_core::GrayImage;
 
 /// Values summed sequentially per leaf of the reduction tree.
@@ -93,16 +94,27 @@ pub struct MedianMad {
 /// Fast method: at most [`MAX_SAMPLES`] pixels, every `stride`-th one in memory order with
 /// `stride = ceil(len / MAX_SAMPLES)` made odd (so that the samples do not fall on the same
 /// columns row after row), copied into `samples` (reused, so nothing is allocated once it has
-/// grown); two `select_nth_unstable` passes (expected linear time) give the median and the
-/// MAD. Sequential and thread-independent. NaN pixels sort above every number.
+/// grown) in parallel chunks, each read missing the cache; two `select_nth_unstable` passes
+/// (expected linear time) give the median and the MAD. The same samples, so the same result,
+/// whatever the number of threads. NaN pixels sort above every number.
 pub fn median_mad(image: &GrayImage, samples: &mut Vec<f32>) -> Option<MedianMad> {
     let values = image.as_slice();
     if values.is_empty() {
         return None;
     }
     let stride = values.len().div_ceil(MAX_SAMPLES) | 1;
+    const CHUNK: usize = 4096;
     samples.clear();
-    samples.extend(values.iter().step_by(stride));
+    samples.resize(values.len().div_ceil(stride), 0.0);
+    samples
+        .par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(chunk, out)| {
+            let first = chunk * CHUNK * stride;
+            for (o, &v) in out.iter_mut().zip(values[first..].iter().step_by(stride)) {
+                *o = v;
+            }
+        });
     let median = f64::from(median_of(samples));
     for v in samples.iter_mut() {
         *v = (f64::from(*v) - median).abs() as f32;
