@@ -9,8 +9,9 @@
 //!    touching beads separate, 8-connected components with an area up to `π(⌈r_b/2⌉+1)²`,
 //!    their centroids (sub-pixel);
 //! 3. **erasing** (the closing runs beside step 2): the background is the closing of the
-//!    frame by a disk of radius `⌊1.5·r_b⌋`; the black top-hat `closing − f` is set to 0 on the base and on a disk of
-//!    radius `r_b` around each black bead (the frame replaced by its background there);
+//!    frame by a disk of radius `⌊1.5·r_b⌋`; the black top-hat `closing − f` is set to 0 on
+//!    the base and on a disk of radius `r_b` around each black bead (the frame replaced by
+//!    its background there);
 //! 4. **transparent beads** (module `transparent`): h-concave transform of the top-hat (basins
 //!    filled up to h), normalised cross-correlation with the ring template, two 3×3 means,
 //!    local maxima; maxima on pixels darker than `2·τ_b` are dropped; those with a
