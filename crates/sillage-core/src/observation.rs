@@ -136,6 +136,12 @@ pub struct TrackPoint {
     /// variances (particle filters: the weighted particle spread; Kalman: the posterior).
     #[serde(default)]
     pub spread_px: Option<f64>,
+    /// Index of the detection this point is, in its frame's
+    /// [`FrameObservations::detections`](crate::FrameObservations::detections) (`None` where the point is an estimate rather than
+    /// a detection, or the tracker does not say; the PTV tracker always says). Joins a point
+    /// back to its detection's other attributes without matching coordinates.
+    #[serde(default)]
+    pub detection: Option<u32>,
 }
 
 impl TrackPoint {
@@ -152,6 +158,7 @@ impl TrackPoint {
             motion_state: MotionState::Unknown,
             class: 0,
             spread_px: None,
+            detection: None,
         }
     }
 }

@@ -1,9 +1,6 @@
 //! Linking a table of detections (one row per detection, trackpy's layout) with the PTV
 //! tracker, and carrying the trajectory ids back to the rows.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
 use numpy::ndarray::ArrayView1;
 use sillage::core::{Detection, Error, FrameIndex, Point2, Result, TrackPoint, TrackSink};
 use sillage::{Pipeline, PipelineConfig};
@@ -48,24 +45,10 @@ pub fn link_rows(
     if !frame.iter().is_sorted() {
         order.sort_unstable_by_key(|&row| (frame[row], row));
     }
-
-    // Where each emitted point comes from: (frame, x bits, y bits) → row, the tracker
-    // emitting the detections' own coordinates. Rows at the same place in the same frame are
-    // chained through `same_place`.
-    let key = |row: usize| (frame[row], x[row].to_bits(), y[row].to_bits());
-    let mut row_at: HashMap<(i64, u64, u64), usize, BuildHasherDefault<PlaceHasher>> =
-        HashMap::with_capacity_and_hasher(rows, BuildHasherDefault::default());
-    let mut same_place = vec![usize::MAX; rows];
-    for &row in order.iter().rev() {
-        if let Some(next) = row_at.insert(key(row), row) {
-            same_place[row] = next;
-        }
-    }
-
     let inputs = frame_inputs(&order, frame, x, y);
     let mut writer = RowWriter {
-        row_at,
-        same_place,
+        frame_starts: frame_starts(&order, frame),
+        order: &order,
         linked: LinkedRows {
             particle: vec![-1; rows],
             vx: vec![f64::NAN; rows],
@@ -87,43 +70,67 @@ pub fn link_rows(
 
 /// A track sink that writes each point's id and velocity into the row it came from as the
 /// tracker emits it (a run of 20 frames of 20,000 points would otherwise hold ~350,000 track
-/// points of ~150 bytes before mapping them).
-struct RowWriter {
-    /// (frame, x bits, y bits) → the next row at that place not yet given a point.
-    row_at: HashMap<(i64, u64, u64), usize, BuildHasherDefault<PlaceHasher>>,
-    /// Per row: the next row of the same frame at the same place (`usize::MAX`: none).
-    same_place: Vec<usize>,
+/// points of ~150 bytes before mapping them). The row is found from the point's frame and
+/// detection index: frame `f`'s detections are the rows `order[start..]` from its start.
+struct RowWriter<'a> {
+    /// (frame number, first position in `order`) of every frame with rows, in frame order.
+    frame_starts: Vec<(i64, usize)>,
+    /// The rows sorted by frame, as the detections were handed to the tracker.
+    order: &'a [usize],
     linked: LinkedRows,
 }
 
-impl TrackSink for RowWriter {
+impl TrackSink for RowWriter<'_> {
     fn accept(&mut self, points: &[TrackPoint]) -> Result<()> {
+        // The points of one call are mostly of one frame: its rows are looked up once.
+        let mut frame_rows: Option<(u64, &[usize])> = None;
         for point in points {
-            let place = (
-                point.frame as i64,
-                point.pos_px.x.to_bits(),
-                point.pos_px.y.to_bits(),
-            );
-            let row = self
-                .row_at
-                .get_mut(&place)
-                .filter(|row| **row != usize::MAX);
-            let Some(row) = row else {
+            let rows = match frame_rows {
+                Some((frame, rows)) if frame == point.frame => rows,
+                _ => {
+                    let rows = rows_of(&self.frame_starts, self.order, point.frame as i64);
+                    frame_rows = Some((point.frame, rows));
+                    rows
+                }
+            };
+            let Some(&row) = point.detection.and_then(|d| rows.get(d as usize)) else {
                 return Err(Error::input(format!(
-                    "internal: the tracker emitted a point at ({}, {}) in frame {} that is no row",
-                    point.pos_px.x, point.pos_px.y, point.frame
+                    "internal: the tracker emitted a point of frame {} (detection {:?}) that is \
+                     no row",
+                    point.frame, point.detection
                 )));
             };
-            let at = *row;
-            *row = self.same_place[at];
-            self.linked.particle[at] = point.track_id as i64;
+            self.linked.particle[row] = point.track_id as i64;
             if let Some(v) = point.vel_px_per_frame {
-                self.linked.vx[at] = v.x;
-                self.linked.vy[at] = v.y;
+                self.linked.vx[row] = v.x;
+                self.linked.vy[row] = v.y;
             }
         }
         Ok(())
     }
+}
+
+/// The rows of frame `frame` in `order`, in the order of its detections (none when it has no
+/// row), from the `frame_starts` of [`frame_starts`].
+fn rows_of<'o>(frame_starts: &[(i64, usize)], order: &'o [usize], frame: i64) -> &'o [usize] {
+    match frame_starts.binary_search_by_key(&frame, |&(f, _)| f) {
+        Ok(at) => {
+            let end = frame_starts.get(at + 1).map_or(order.len(), |&(_, s)| s);
+            &order[frame_starts[at].1..end]
+        }
+        Err(_) => &[],
+    }
+}
+
+/// (frame number, first position in `order`) of every frame that has rows, in frame order.
+fn frame_starts(order: &[usize], frame: ArrayView1<'_, i64>) -> Vec<(i64, usize)> {
+    let mut starts: Vec<(i64, usize)> = Vec::new();
+    for (position, &row) in order.iter().enumerate() {
+        if starts.last().is_none_or(|&(f, _)| f != frame[row]) {
+            starts.push((frame[row], position));
+        }
+    }
+    starts
 }
 
 /// The detections of every frame from the first to the last row's, in order (rows sorted by
@@ -154,30 +161,4 @@ fn frame_inputs<'a>(
         previous = Some(number);
         Some(Ok((number as FrameIndex, detections)))
     })
-}
-
-/// A fast hasher for the (frame, x bits, y bits) keys of `link_rows` (FxHash's multiply and
-/// rotate): the keys are not chosen by an adversary, and SipHash's cost showed in profiles
-/// of 20,000-point frames.
-#[derive(Default)]
-struct PlaceHasher(u64);
-
-impl Hasher for PlaceHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for &byte in bytes {
-            self.write_u64(u64::from(byte));
-        }
-    }
-
-    fn write_u64(&mut self, value: u64) {
-        self.0 = (self.0.rotate_left(5) ^ value).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-
-    fn write_i64(&mut self, value: i64) {
-        self.write_u64(value as u64);
-    }
-
-    fn finish(&self) -> u64 {
-        self.0
-    }
 }

@@ -417,6 +417,7 @@ impl PtvTracker {
                     acc_px_per_frame2: Some(t.acc),
                     vel_pred_px_per_frame: Some(vel_pred[t.middle]),
                     log10_pred_err: Some(t.log_err),
+                    detection: Some(t.middle as u32),
                     ..TrackPoint::at(frame, track_id, c1[t.middle])
                 }
             })
