@@ -1,7 +1,11 @@
 //! The local-flow motion model: velocities averaged over the k nearest samples (Eqs. 8, 11).
 
+use rayon::prelude::*;
 use sillage_assoc::PointIndex;
 use sillage_core::{Point2, Vec2};
+
+/// Fewest samples a rayon task lays out in [`MotionField::prepare`].
+const PAR_MIN_SLOTS: usize = 4096;
 
 /// Log error given to points whose model has no weight (TracTrac's fill value).
 const UNKNOWN_LOG_ERR: f64 = 2.0;
@@ -58,6 +62,9 @@ pub(crate) struct MotionField {
     counts: Vec<u8>,
     /// Per stored sample: the recent sample at the same position, if any.
     partners: Vec<Option<usize>>,
+    /// Whether the last `prepare` indexed the stored positions with counts (steady state)
+    /// rather than the concatenation of both sets.
+    counted: bool,
     /// Per query: the weighted mean velocity and log error (NaN when weightless).
     means: Vec<(Vec2, f64)>,
 }
@@ -75,37 +82,20 @@ impl MotionField {
             by_slot: Vec::new(),
             counts: Vec::new(),
             partners: Vec::new(),
+            counted: false,
             means: Vec::new(),
         }
     }
 
-    /// For every query: the weighted mean velocity `u` (Eq. 8) and log error `e` (Eq. 11)
-    /// of its `k` nearest samples among `recent` (the good tracklets, weight 1) and `stored`
-    /// (the model kept from the previous step, weight `filter_time`), as TracTrac's
-    /// `Propagate_MotionModel_KdTree`. Queries whose neighbours weigh nothing get u = 0,
-    /// e = 2; the others become the model to store, written to `next`.
+    /// Indexes the samples: `recent` (the good tracklets, weight 1) and `stored` (the model
+    /// kept from the previous step, weight `filter_time`). Call before
+    /// [`MotionField::evaluate`]; it is separate so that the tracker can run it beside the
+    /// other index it builds at the start of a step.
     ///
-    /// The neighbours and their summation order (nearest first, ties to `recent` and then
-    /// to the lower index) are those of a k-d tree query over the concatenation. In steady
-    /// state every recent sample sits exactly on a stored one (both are points of the same
-    /// frame, in the same order): the stored positions alone are then indexed, each standing
-    /// for one or two samples, which halves the index and the neighbours to find. There, two
-    /// different points at exactly the same distance from a query give their samples point
-    /// by point rather than recent ones first.
-    ///
-    /// Eq. (8) as printed lost its bars; it reads
-    /// v̄ᵢ(t) = 1/min(k, N̂) Σⱼ [α v̂ᵢⱼ(t−1) + (1−α) v̄ᵢⱼ(t−1)]: a mix of tracklet velocities
-    /// and earlier model velocities. The code (and this function) averages the k nearest of
-    /// the union of both sets instead, with weights 1 and `filter_time`.
-    pub fn evaluate(
-        &mut self,
-        queries: &[Point2],
-        recent: &Samples,
-        stored: &Samples,
-        u: &mut Vec<Vec2>,
-        e: &mut Vec<f64>,
-        next: &mut Samples,
-    ) {
+    /// In steady state every recent sample sits exactly on a stored one (both are points of
+    /// the same frame, in the same order): the stored positions alone are then indexed, each
+    /// standing for one or two samples, which halves the index and the neighbours to find.
+    pub fn prepare(&mut self, recent: &Samples, stored: &Samples) {
         let recent_sample = |i: usize| Weighted {
             weight: 1.0,
             vel: recent.vel[i],
@@ -116,20 +106,66 @@ impl MotionField {
             vel: stored.vel[i],
             log_err: stored.log_err[i],
         };
-        self.by_slot.clear();
-        if pair_with_stored(recent, stored, &mut self.partners) {
+        self.counted = pair_with_stored(recent, stored, &mut self.partners);
+        if self.counted {
             self.index.rebuild(&stored.pos);
-            self.counts.clear();
-            for &i in self.index.slot_indexes() {
-                let i = i as usize;
-                let (copies, count) = match self.partners[i] {
-                    Some(r) => ([recent_sample(r), stored_sample(i)], 2),
-                    None => ([stored_sample(i), Weighted::default()], 1),
-                };
-                self.by_slot.push(copies);
-                self.counts.push(count);
-            }
-            let (by_slot, counts) = (&self.by_slot, &self.counts);
+            let partners = &self.partners;
+            let slots = self.index.slot_indexes();
+            slots
+                .par_iter()
+                .with_min_len(PAR_MIN_SLOTS)
+                .map(|&i| match partners[i as usize] {
+                    Some(r) => [recent_sample(r), stored_sample(i as usize)],
+                    None => [stored_sample(i as usize), Weighted::default()],
+                })
+                .collect_into_vec(&mut self.by_slot);
+            slots
+                .par_iter()
+                .with_min_len(PAR_MIN_SLOTS)
+                .map(|&i| if partners[i as usize].is_some() { 2 } else { 1 })
+                .collect_into_vec(&mut self.counts);
+        } else {
+            self.index.rebuild_concat(&recent.pos, &stored.pos);
+            let n_recent = recent.len();
+            self.by_slot.clear();
+            self.by_slot
+                .extend(self.index.slot_indexes().iter().map(|&i| {
+                    let i = i as usize;
+                    let sample = if i < n_recent {
+                        recent_sample(i)
+                    } else {
+                        stored_sample(i - n_recent)
+                    };
+                    [sample, Weighted::default()]
+                }));
+        }
+    }
+
+    /// For every query: the weighted mean velocity `u` (Eq. 8) and log error `e` (Eq. 11)
+    /// of its `k` nearest samples among those of the last [`MotionField::prepare`], as
+    /// TracTrac's `Propagate_MotionModel_KdTree`. Queries whose neighbours weigh nothing get
+    /// u = 0, e = 2; the others become the model to store, written to `next`.
+    ///
+    /// The neighbours and their summation order (nearest first, ties to `recent` and then
+    /// to the lower index) are those of a k-d tree query over the concatenation
+    /// `recent ++ stored`; on the steady-state path of [`MotionField::prepare`], two
+    /// different points at exactly the same distance from a query give their samples point
+    /// by point rather than recent ones first.
+    ///
+    /// Eq. (8) as printed lost its bars; it reads
+    /// v̄ᵢ(t) = 1/min(k, N̂) Σⱼ [α v̂ᵢⱼ(t−1) + (1−α) v̄ᵢⱼ(t−1)]: a mix of tracklet velocities
+    /// and earlier model velocities. The code (and this function) averages the k nearest of
+    /// the union of both sets instead, with weights 1 and `filter_time`.
+    pub fn evaluate(
+        &mut self,
+        queries: &[Point2],
+        u: &mut Vec<Vec2>,
+        e: &mut Vec<f64>,
+        next: &mut Samples,
+    ) {
+        let by_slot = &self.by_slot;
+        if self.counted {
+            let counts = &self.counts;
             self.index.map_k_nearest_counted(
                 queries,
                 self.k,
@@ -147,19 +183,6 @@ impl MotionField {
                 },
             );
         } else {
-            self.index.rebuild_concat(&recent.pos, &stored.pos);
-            let n_recent = recent.len();
-            self.by_slot
-                .extend(self.index.slot_indexes().iter().map(|&i| {
-                    let i = i as usize;
-                    let sample = if i < n_recent {
-                        recent_sample(i)
-                    } else {
-                        stored_sample(i - n_recent)
-                    };
-                    [sample, Weighted::default()]
-                }));
-            let by_slot = &self.by_slot;
             self.index
                 .map_k_nearest(queries, self.k, &mut self.means, |_, slots| {
                     weighted_mean(slots.iter().map(|&s| &by_slot[s as usize][0]))
@@ -269,7 +292,8 @@ mod tests {
         for (recent, k, w) in [(&recent, 10, 1.0), (&recent, 7, 0.5), (&moved, 10, 1.0)] {
             let mut field = MotionField::new(k, w);
             let (mut u, mut e, mut next) = (Vec::new(), Vec::new(), Samples::default());
-            field.evaluate(&queries, recent, &stored, &mut u, &mut e, &mut next);
+            field.prepare(recent, &stored);
+            field.evaluate(&queries, &mut u, &mut e, &mut next);
             for (i, &q) in queries.iter().enumerate() {
                 let (bu, be) = brute_force(q, k, recent, &stored, w);
                 assert_eq!((u[i], e[i]), (bu, be), "query {i}, k {k}");
@@ -286,14 +310,8 @@ mod tests {
         stored.push(Point2::new(100.0, 0.0), Vec2::new(100.0, 0.0), 5.0);
         let mut field = MotionField::new(2, 2.0);
         let (mut u, mut e, mut next) = (Vec::new(), Vec::new(), Samples::default());
-        field.evaluate(
-            &[Point2::new(0.2, 0.0)],
-            &recent,
-            &stored,
-            &mut u,
-            &mut e,
-            &mut next,
-        );
+        field.prepare(&recent, &stored);
+        field.evaluate(&[Point2::new(0.2, 0.0)], &mut u, &mut e, &mut next);
         // (1·1 + 2·4) / 3 = 3, (1·(−1) + 2·0) / 3 = −1/3.
         assert_eq!(u, vec![Vec2::new(3.0, 0.0)]);
         assert!((e[0] + 1.0 / 3.0).abs() < 1e-15);
@@ -301,14 +319,8 @@ mod tests {
 
         // Weight 0 on stored samples and no recent one nearby: unknown, not stored.
         let mut field = MotionField::new(1, 0.0);
-        field.evaluate(
-            &[Point2::new(99.0, 0.0)],
-            &recent,
-            &stored,
-            &mut u,
-            &mut e,
-            &mut next,
-        );
+        field.prepare(&recent, &stored);
+        field.evaluate(&[Point2::new(99.0, 0.0)], &mut u, &mut e, &mut next);
         assert_eq!((u[0], e[0], next.len()), (Vec2::ZERO, UNKNOWN_LOG_ERR, 0));
     }
 }
