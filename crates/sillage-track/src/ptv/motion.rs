@@ -172,14 +172,20 @@ impl MotionField {
                 counts,
                 &mut self.means,
                 |slots, last_taken| {
-                    let (last, before) = slots
-                        .split_last()
-                        .map_or((None, slots), |(l, b)| (Some(l), b));
-                    let all = before
-                        .iter()
-                        .flat_map(|&s| &by_slot[s as usize][..usize::from(counts[s as usize])])
-                        .chain(last.map_or(&[][..], |&s| &by_slot[s as usize][..last_taken]));
-                    weighted_mean(all)
+                    // Plain loops rather than one chained iterator: this runs per query.
+                    let mut sum = WeightedSum::default();
+                    if let Some((&last, before)) = slots.split_last() {
+                        for &s in before {
+                            let s = s as usize;
+                            by_slot[s][..usize::from(counts[s])]
+                                .iter()
+                                .for_each(|w| sum.add(w));
+                        }
+                        by_slot[last as usize][..last_taken]
+                            .iter()
+                            .for_each(|w| sum.add(w));
+                    }
+                    sum.mean()
                 },
             );
         } else {
@@ -207,16 +213,35 @@ impl MotionField {
 /// Weighted means of the samples' velocities and log errors, summed in the order given;
 /// NaN when they weigh nothing.
 fn weighted_mean<'a>(samples: impl Iterator<Item = &'a Weighted>) -> (Vec2, f64) {
-    let (mut w_sum, mut v_sum, mut e_sum) = (0.0, Vec2::ZERO, 0.0);
-    for s in samples {
-        w_sum += s.weight;
-        v_sum = v_sum + s.vel * s.weight;
-        e_sum += s.log_err * s.weight;
+    let mut sum = WeightedSum::default();
+    samples.for_each(|s| sum.add(s));
+    sum.mean()
+}
+
+/// Running sums of weights, weighted velocities and weighted log errors.
+#[derive(Default)]
+struct WeightedSum {
+    weight: f64,
+    vel: Vec2,
+    log_err: f64,
+}
+
+impl WeightedSum {
+    #[inline]
+    fn add(&mut self, s: &Weighted) {
+        self.weight += s.weight;
+        self.vel = self.vel + s.vel * s.weight;
+        self.log_err += s.log_err * s.weight;
     }
-    if w_sum > 0.0 {
-        (v_sum / w_sum, e_sum / w_sum)
-    } else {
-        (Vec2::new(f64::NAN, f64::NAN), f64::NAN)
+
+    /// The weighted means (NaN when the samples weigh nothing).
+    #[inline]
+    fn mean(&self) -> (Vec2, f64) {
+        if self.weight > 0.0 {
+            (self.vel / self.weight, self.log_err / self.weight)
+        } else {
+            (Vec2::new(f64::NAN, f64::NAN), f64::NAN)
+        }
     }
 }
 
