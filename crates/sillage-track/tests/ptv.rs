@@ -184,6 +184,11 @@ fn uniform_translation_gives_one_id_per_particle_and_exact_velocities() {
     for p in &points {
         let truth = ids[&(p.frame, p.pos_px.x.to_bits(), p.pos_px.y.to_bits())];
         assert_eq!(*track_of.entry(truth).or_insert(p.track_id), p.track_id);
+        // The point names the detection it is.
+        let d = p.detection.expect("PTV points are detections") as usize;
+        let frame = p.frame as usize;
+        assert_eq!(scene.frames[frame][d].pos_px, p.pos_px);
+        assert_eq!(scene.truth[frame][d], truth);
         let v = p.vel_px_per_frame.unwrap();
         assert!((v - vel).max_abs() < 1e-9, "{v:?}");
         assert!(p.acc_px_per_frame2.unwrap().max_abs() < 1e-9);

@@ -42,6 +42,8 @@ struct Triplet {
     before: usize,
     /// Index in frame t−1 (the middle, emitted frame).
     middle: usize,
+    /// Index in frame t.
+    after: usize,
     vel: Vec2,
     acc: Vec2,
     log_err: f64,
@@ -351,39 +353,42 @@ impl PtvTracker {
         let (c0, c1, c2) = (&self.c0, &self.c1, &self.c2);
         let (vel_pred, log_err_pred) = (&self.vel_pred, &self.log_err_pred);
         let (filter, threshold) = (self.params.filter, self.threshold);
-        // Kinematics in parallel (the log10 dominates), in middle-point order.
+        // The linked triplets in middle-point order, then their kinematics in parallel, in
+        // place (the log10 dominates; collecting filtered results in parallel cost twice as
+        // much in allocations and copies).
         self.triplets.clear();
-        self.triplets.par_extend(
-            self.link01
-                .par_iter()
-                .zip(&self.link12)
-                .enumerate()
-                .with_min_len(PAR_MIN_LEN)
-                .filter_map(|(middle, (&back, &ahead))| {
-                    let (before, after) = (back?, ahead?);
-                    let (x0, x1, x2) = (c0[before], c1[middle], c2[after]);
-                    let u0 = (x1 - x0) / dt;
-                    let u1 = (x2 - x1) / dt;
-                    // Eq. (6): v(t−1) = (x(t) − x(t−2)) / 2Δt, the mean of the two finite
-                    // differences.
-                    let vel = (u0 + u1) * 0.5;
-                    // Eq. (7), whose signs were lost in the text:
-                    // a(t−1) = (x(t) − 2x(t−1) + x(t−2)) / Δt².
-                    let acc = (u1 - u0) / dt;
-                    let log_err = log10_error(vel_pred[middle], vel, dt);
-                    // §3.1.3: outlier when ε − ε̄ ≥ threshold (the threshold stands for
-                    // n_σ·σ̄_ε).
-                    let kept = !filter || log_err - log_err_pred[middle] < threshold;
+        self.triplets
+            .extend(self.link01.iter().zip(&self.link12).enumerate().filter_map(
+                |(middle, (&back, &ahead))| {
                     Some(Triplet {
-                        before,
+                        before: back?,
                         middle,
-                        vel,
-                        acc,
-                        log_err,
-                        kept,
+                        after: ahead?,
+                        vel: Vec2::ZERO,
+                        acc: Vec2::ZERO,
+                        log_err: 0.0,
+                        kept: false,
                     })
-                }),
-        );
+                },
+            ));
+        self.triplets
+            .par_iter_mut()
+            .with_min_len(PAR_MIN_LEN)
+            .for_each(|t| {
+                let (x0, x1, x2) = (c0[t.before], c1[t.middle], c2[t.after]);
+                let u0 = (x1 - x0) / dt;
+                let u1 = (x2 - x1) / dt;
+                // Eq. (6): v(t−1) = (x(t) − x(t−2)) / 2Δt, the mean of the two finite
+                // differences.
+                t.vel = (u0 + u1) * 0.5;
+                // Eq. (7), whose signs were lost in the text:
+                // a(t−1) = (x(t) − 2x(t−1) + x(t−2)) / Δt².
+                t.acc = (u1 - u0) / dt;
+                t.log_err = log10_error(vel_pred[t.middle], t.vel, dt);
+                // §3.1.3: outlier when ε − ε̄ ≥ threshold (the threshold stands for
+                // n_σ·σ̄_ε).
+                t.kept = !filter || t.log_err - log_err_pred[t.middle] < threshold;
+            });
         self.errors.clear();
         self.errors.extend(self.triplets.iter().map(|t| t.log_err));
         self.current.clear();
