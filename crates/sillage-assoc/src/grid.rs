@@ -254,8 +254,12 @@ impl PointIndex {
     /// their points to `visitor`. A row or cell of a ring is skipped when it lies farther
     /// than the squared distance a point must beat, and the search stops when every cell
     /// not yet visited does.
+    ///
+    /// Visitors with [`Visitor::BLOCK_FIRST`] start with the whole 3×3 block around `p`'s
+    /// cell; the others with `p`'s own cell, so that a search within a small distance
+    /// touches the cells that distance reaches only.
     #[inline]
-    fn search(&self, p: Point2, visitor: &mut impl Visitor) {
+    fn search<V: Visitor>(&self, p: Point2, visitor: &mut V) {
         if self.xs.is_empty() || !p.is_finite() {
             return;
         }
@@ -264,7 +268,7 @@ impl PointIndex {
         let cy = self.cell_coord(p.y - self.origin.y);
         let mut r_first = 0.max(-cx).max(cx - (nx - 1)).max(-cy).max(cy - (ny - 1));
         let r_last = cx.max(nx - 1 - cx).max(cy).max(ny - 1 - cy);
-        if r_first == 0 {
+        if r_first == 0 && V::BLOCK_FIRST {
             // Inside the grid: the 3×3 block first, as three row runs (each run of cells is
             // contiguous in storage), the query's own row first and then the row on its side,
             // so the k-th best tightens early and farther cells are skipped or rejected point
@@ -387,6 +391,25 @@ impl PointIndex {
             self.search(p, &mut best);
         }
         (best.n, best.samples)
+    }
+
+    /// Whether the indexed point `candidate`, held at `candidate_at`, is the nearest indexed
+    /// point to `p` (ties to the lower index), i.e. whether [`NeighbourIndex::nearest`]
+    /// would answer it. Only the cells within the candidate's distance are searched, and
+    /// the search stops at the first point that ranks before it: when the candidate is
+    /// close to `p`, as a predicted position to its match, this is a small fraction of a
+    /// nearest query. `candidate_at` must be the position the index was built from.
+    pub fn is_nearest(&self, p: Point2, candidate: usize, candidate_at: Point2) -> bool {
+        let (dx, dy) = (p.x - candidate_at.x, p.y - candidate_at.y);
+        let mut rival = Rival {
+            px: p.x,
+            py: p.y,
+            d2: dx * dx + dy * dy,
+            id: candidate as u32,
+            found: false,
+        };
+        self.search(p, &mut rival);
+        !rival.found
     }
 
     /// Calls `f(index, squared distance)` for every point within `radius` of `p` (distance
@@ -523,6 +546,10 @@ fn with_scratch<R>(k: usize, f: impl FnOnce(&mut [f64], &mut [u64]) -> R) -> R {
 
 /// What a grid search collects.
 trait Visitor {
+    /// Whether the search starts with the whole 3×3 block around the query's cell (the
+    /// fastest start when the answer is usually found there) rather than its own cell.
+    const BLOCK_FIRST: bool = true;
+
     /// Offers the points of a run of cells: coordinates and original indexes, held in the
     /// storage slots `first_slot..`.
     fn visit(&mut self, first_slot: usize, xs: &[f64], ys: &[f64], ids: &[u32]);
@@ -554,6 +581,42 @@ impl Visitor for Nearest {
     #[inline]
     fn worst_d2(&self) -> f64 {
         self.d2
+    }
+}
+
+/// Looks for a point that ranks before a candidate (closer, or as close with a lower
+/// index); once one is found nothing more can matter, so the distance to beat drops below
+/// zero and the search ends.
+struct Rival {
+    px: f64,
+    py: f64,
+    d2: f64,
+    id: u32,
+    found: bool,
+}
+
+impl Visitor for Rival {
+    const BLOCK_FIRST: bool = false;
+
+    #[inline]
+    fn visit(&mut self, _first_slot: usize, xs: &[f64], ys: &[f64], ids: &[u32]) {
+        if self.found {
+            return;
+        }
+        for ((&x, &y), &id) in xs.iter().zip(ys).zip(ids) {
+            // Computed as `Nearest::visit`, so that ties are decided alike.
+            let (dx, dy) = (self.px - x, self.py - y);
+            let d = dx * dx + dy * dy;
+            if d < self.d2 || (d == self.d2 && id < self.id) {
+                self.found = true;
+                return;
+            }
+        }
+    }
+
+    #[inline]
+    fn worst_d2(&self) -> f64 {
+        if self.found { -1.0 } else { self.d2 }
     }
 }
 

@@ -55,5 +55,5 @@ pub use brute::BruteForceIndex;
 pub use grid::PointIndex;
 pub use index::{Neighbour, NeighbourIndex};
 pub use lap::{LapSolver, solve_assignment};
-pub use mutual::{mutual_nearest_neighbours, mutual_pairs};
+pub use mutual::{mutual_nearest_neighbours, mutual_pairs, mutual_pairs_from_forward};
 pub use sparse_lap::{Pairing, SparseLapSolver};

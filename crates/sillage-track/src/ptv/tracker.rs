@@ -1,7 +1,7 @@
 //! The PTV tracker: three-frame association, kinematics, outlier filter, id hand-over.
 
 use rayon::prelude::*;
-use sillage_assoc::{Neighbour, NeighbourIndex, PointIndex, mutual_pairs};
+use sillage_assoc::{Neighbour, NeighbourIndex, PointIndex, mutual_pairs_from_forward};
 use sillage_core::{
     Error, FrameIndex, FrameObservations, Point2, Result, TrackId, TrackPoint, TrackSink, Tracker,
     Vec2,
@@ -105,7 +105,6 @@ pub struct PtvTracker {
     voted: Vec<Vec2>,
     forward: Vec<Option<Neighbour>>,
     two_nearest: Vec<Vec<Neighbour>>,
-    backward: Vec<Option<Neighbour>>,
     link12: Vec<Option<usize>>,
     link21: Vec<Option<usize>>,
     triplets: Vec<Triplet>,
@@ -149,7 +148,6 @@ impl PtvTracker {
             voted: Vec::new(),
             forward: Vec::new(),
             two_nearest: Vec::new(),
-            backward: Vec::new(),
             link12: Vec::new(),
             link21: Vec::new(),
             triplets: Vec::new(),
@@ -306,7 +304,7 @@ impl PtvTracker {
     /// its index is reused too.
     fn associate(&mut self, model_applied: bool) {
         // The predictions' index is built while frame t's index answers the forward queries.
-        let (pred, c2, index_c2) = (&self.pred, &self.c2, &self.index_c2);
+        let (pred, index_c2) = (&self.pred, &self.index_c2);
         let (forward, two_nearest) = (&mut self.forward, &mut self.two_nearest);
         let mut forward_queries = || {
             if self.params.ambiguity_ratio.is_some() {
@@ -317,17 +315,25 @@ impl PtvTracker {
                 index_c2.nearest_batch(pred, forward);
             }
         };
-        let pred_index = if model_applied {
+        let c2 = &self.c2;
+        let (pred_index, pred) = if model_applied {
             let index_pred = &mut self.index_pred;
             rayon::join(|| index_pred.rebuild(pred), forward_queries);
-            &self.index_pred
+            (&self.index_pred, pred)
         } else {
             forward_queries();
-            &self.index_c1
+            (&self.index_c1, &self.c1)
         };
-        pred_index.nearest_batch(c2, &mut self.backward);
-        mutual_pairs(&self.forward, &self.backward, None, &mut self.link12);
-        mutual_pairs(&self.backward, &self.forward, None, &mut self.link21);
+        // The backward half of the mutual test, checked within each forward pair's
+        // distance only (a fraction of a nearest query when the prediction is good).
+        mutual_pairs_from_forward(
+            pred_index,
+            pred,
+            c2,
+            &self.forward,
+            &mut self.link12,
+            &mut self.link21,
+        );
         if let Some(ratio) = self.params.ambiguity_ratio {
             let two = &self.two_nearest;
             retain_links(
