@@ -22,7 +22,7 @@
 use rayon::prelude::*;
 use sillage_core::Point2;
 
-use crate::index::{Neighbour, NeighbourIndex};
+use crate::index::{MIN_QUERIES_PER_TASK, Neighbour, NeighbourIndex};
 
 /// Default mean number of points per grid cell: the 3×3 block first searched then holds
 /// the nearest point of 96 % of uniform queries (1 − e^−π), and nearest-neighbour batches
@@ -327,6 +327,55 @@ impl PointIndex {
                 }
             }
         }
+    }
+
+    /// [`NeighbourIndex::nearest_batch`] for queries that mostly lie much closer to their
+    /// nearest point than the spacing between points, as predicted positions to their
+    /// matches in particle tracking: each query first looks in its own cell only and stops
+    /// there when nothing outside can be closer. Same answers; faster on such queries
+    /// (PTV's forward association), ~15-20 % slower on queries scattered at random.
+    pub fn nearest_batch_near(&self, queries: &[Point2], out: &mut Vec<Option<Neighbour>>) {
+        queries
+            .par_iter()
+            .with_min_len(MIN_QUERIES_PER_TASK)
+            .map(|&q| self.nearest_from(q, true))
+            .collect_into_vec(out);
+    }
+
+    /// The nearest point to `p`, trying `p`'s own cell alone first when `own_cell_first`.
+    #[inline]
+    fn nearest_from(&self, p: Point2, own_cell_first: bool) -> Option<Neighbour> {
+        let mut nearest = Nearest {
+            px: p.x,
+            py: p.y,
+            d2: f64::INFINITY,
+            id: NO_POINT,
+        };
+        if !(own_cell_first && self.settled_in_own_cell(p, &mut nearest)) {
+            self.search(p, &mut nearest);
+        }
+        (nearest.id != NO_POINT).then(|| (nearest.id as usize, nearest.d2.sqrt()))
+    }
+
+    /// Visits the points of `p`'s own cell and returns true when the nearest of them is
+    /// closer than any point outside the cell can be: then the search is over after one
+    /// cell. Queries that sit on an indexed point, as a well-predicted position sits on its
+    /// match, mostly end here; the others go on with the full search, which visits the
+    /// cell again (harmless for a nearest point: a point never ranks before itself).
+    #[inline]
+    fn settled_in_own_cell(&self, p: Point2, nearest: &mut Nearest) -> bool {
+        if self.xs.is_empty() || !p.is_finite() {
+            return false;
+        }
+        let cx = self.cell_coord(p.x - self.origin.x);
+        let cy = self.cell_coord(p.y - self.origin.y);
+        if !((0..self.nx as i64).contains(&cx) && (0..self.ny as i64).contains(&cy)) {
+            return false;
+        }
+        let cell = cy as usize * self.nx + cx as usize;
+        self.visit_cells(cell, cell, nearest);
+        let bound = self.unvisited_bound(p, cx, cy, 0);
+        bound > 0.0 && nearest.d2 < bound * bound
     }
 
     /// Hands the points of cells `first..=last` (contiguous in storage) to `visitor`.
@@ -763,14 +812,7 @@ impl NeighbourIndex for PointIndex {
     }
 
     fn nearest(&self, p: Point2) -> Option<Neighbour> {
-        let mut nearest = Nearest {
-            px: p.x,
-            py: p.y,
-            d2: f64::INFINITY,
-            id: NO_POINT,
-        };
-        self.search(p, &mut nearest);
-        (nearest.id != NO_POINT).then(|| (nearest.id as usize, nearest.d2.sqrt()))
+        self.nearest_from(p, false)
     }
 
     fn k_nearest(&self, p: Point2, k: usize, out: &mut Vec<Neighbour>) {
@@ -856,6 +898,34 @@ mod tests {
         index.for_each_within(Point2::new(f64::NAN, 0.0), 10.0, |_, _| none += 1);
         index.for_each_within(Point2::new(5.0, 5.0), -1.0, |_, _| none += 1);
         assert_eq!(none, 0);
+    }
+
+    #[test]
+    fn near_queries_get_the_nearest_batch_answers() {
+        // A jittered lattice with repeated points; queries on the points, slightly off
+        // them, exactly between them (ties), scattered, and outside the box.
+        let pts: Vec<_> = (0..900)
+            .map(|i| {
+                let j = (i * 7919 % 101) as f64 / 101.0;
+                Point2::new((i % 30) as f64 * 3.0 + j, (i / 30) as f64 * 3.0 - j)
+            })
+            .chain([Point2::new(20.0, 20.0); 3])
+            .collect();
+        let index = PointIndex::new(&pts);
+        let queries: Vec<_> = pts
+            .iter()
+            .enumerate()
+            .map(|(i, p)| match i % 4 {
+                0 => *p,
+                1 => Point2::new(p.x + 0.2, p.y - 0.1),
+                2 => Point2::new((i % 30) as f64 * 3.0 + 1.5, (i / 30) as f64 * 3.0),
+                _ => Point2::new((i * 37 % 113) as f64 - 10.0, (i * 53 % 97) as f64 - 5.0),
+            })
+            .collect();
+        let (mut near, mut plain) = (Vec::new(), Vec::new());
+        index.nearest_batch_near(&queries, &mut near);
+        index.nearest_batch(&queries, &mut plain);
+        assert_eq!(near, plain);
     }
 
     #[test]

@@ -7,7 +7,7 @@ use sillage_core::Point2;
 pub type Neighbour = (usize, f64);
 
 /// Fewest queries a rayon task handles in the batch queries (keeps task overhead small).
-const MIN_QUERIES_PER_TASK: usize = 256;
+pub(crate) const MIN_QUERIES_PER_TASK: usize = 256;
 
 /// Nearest and k-nearest neighbour queries over a fixed set of points.
 ///

@@ -312,7 +312,7 @@ impl PtvTracker {
                 forward.clear();
                 forward.extend(two_nearest.iter().map(|n| n.first().copied()));
             } else {
-                index_c2.nearest_batch(pred, forward);
+                index_c2.nearest_batch_near(pred, forward);
             }
         };
         let c2 = &self.c2;
