@@ -5,8 +5,8 @@
 //! - [`PointIndex`]: the fast index, a uniform grid hash built once per frame in O(n)
 //!   (see its docs for why a grid rather than a k-d tree), rebuilt in place to reuse memory.
 //! - [`BruteForceIndex`]: the obviously-correct O(n) reference the grid is tested against.
-//! - [`mutual_nearest_neighbours`] / [`mutual_pairs`]: the unequivocal forward-backward
-//!   association of TracTrac (§3.1.2 of the TracTrac paper).
+//! - [`mutual_nearest_neighbours`] / [`mutual_pairs_from_forward`] / [`mutual_pairs`]: the
+//!   unequivocal forward-backward association of TracTrac (§3.1.2 of the TracTrac paper).
 //! - [`LapSolver`] / [`solve_assignment`]: optimal one-to-one assignment on a dense
 //!   rectangular cost matrix with forbidden pairs (Jonker–Volgenant shortest augmenting
 //!   paths), checked against exhaustive search.

@@ -11,17 +11,26 @@ use crate::{Neighbour, NeighbourIndex, PointIndex};
 /// TracTrac paper; ambiguous points get `None`.
 ///
 /// Builds one [`PointIndex`] per set; callers that already hold indexes (a tracker reusing
-/// a frame's index) call [`mutual_pairs`] on their own nearest-neighbour answers.
+/// a frame's index) call [`mutual_pairs_from_forward`] (or [`mutual_pairs`]) on their own
+/// nearest-neighbour answers.
 pub fn mutual_nearest_neighbours(
     from: &[Point2],
     to: &[Point2],
     max_distance: Option<f64>,
 ) -> Vec<Option<usize>> {
-    let (from_index, to_index) = (PointIndex::new(from), PointIndex::new(to));
-    let (mut forward, mut backward, mut out) = (Vec::new(), Vec::new(), Vec::new());
+    let (to_index, from_index) = (PointIndex::new(to), PointIndex::new(from));
+    let (mut forward, mut out, mut to_links) = (Vec::new(), Vec::new(), Vec::new());
     to_index.nearest_batch(from, &mut forward);
-    from_index.nearest_batch(to, &mut backward);
-    mutual_pairs(&forward, &backward, max_distance, &mut out);
+    mutual_pairs_from_forward(&from_index, from, to, &forward, &mut out, &mut to_links);
+    if let Some(limit) = max_distance {
+        // As `mutual_pairs`: a NaN limit keeps nothing.
+        let within = |d: f64| d <= limit;
+        for (link, f) in out.iter_mut().zip(&forward) {
+            if f.is_some_and(|(_, d)| !within(d)) {
+                *link = None;
+            }
+        }
+    }
     out
 }
 
