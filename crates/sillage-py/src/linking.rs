@@ -45,9 +45,10 @@ pub fn link_rows(
     if !frame.iter().is_sorted() {
         order.sort_unstable_by_key(|&row| (frame[row], row));
     }
-    let inputs = frame_inputs(&order, frame, x, y);
+    let starts = frame_starts(&order, frame);
+    let inputs = frame_inputs(&starts, &order, x, y);
     let mut writer = RowWriter {
-        frame_starts: frame_starts(&order, frame),
+        frame_starts: &starts,
         order: &order,
         linked: LinkedRows {
             particle: vec![-1; rows],
@@ -74,7 +75,7 @@ pub fn link_rows(
 /// detection index: frame `f`'s detections are the rows `order[start..]` from its start.
 struct RowWriter<'a> {
     /// (frame number, first position in `order`) of every frame with rows, in frame order.
-    frame_starts: Vec<(i64, usize)>,
+    frame_starts: &'a [(i64, usize)],
     /// The rows sorted by frame, as the detections were handed to the tracker.
     order: &'a [usize],
     linked: LinkedRows,
@@ -88,7 +89,7 @@ impl TrackSink for RowWriter<'_> {
             let rows = match frame_rows {
                 Some((frame, rows)) if frame == point.frame => rows,
                 _ => {
-                    let rows = rows_of(&self.frame_starts, self.order, point.frame as i64);
+                    let rows = rows_of(self.frame_starts, self.order, point.frame as i64);
                     frame_rows = Some((point.frame, rows));
                     rows
                 }
@@ -113,13 +114,15 @@ impl TrackSink for RowWriter<'_> {
 /// The rows of frame `frame` in `order`, in the order of its detections (none when it has no
 /// row), from the `frame_starts` of [`frame_starts`].
 fn rows_of<'o>(frame_starts: &[(i64, usize)], order: &'o [usize], frame: i64) -> &'o [usize] {
-    match frame_starts.binary_search_by_key(&frame, |&(f, _)| f) {
-        Ok(at) => {
-            let end = frame_starts.get(at + 1).map_or(order.len(), |&(_, s)| s);
-            &order[frame_starts[at].1..end]
-        }
-        Err(_) => &[],
-    }
+    frame_starts
+        .binary_search_by_key(&frame, |&(f, _)| f)
+        .map_or(&[], |at| rows_at(frame_starts, order, at))
+}
+
+/// The rows of the `at`-th frame of `frame_starts`.
+fn rows_at<'o>(frame_starts: &[(i64, usize)], order: &'o [usize], at: usize) -> &'o [usize] {
+    let end = frame_starts.get(at + 1).map_or(order.len(), |&(_, s)| s);
+    &order[frame_starts[at].1..end]
 }
 
 /// (frame number, first position in `order`) of every frame that has rows, in frame order.
@@ -133,32 +136,30 @@ fn frame_starts(order: &[usize], frame: ArrayView1<'_, i64>) -> Vec<(i64, usize)
     starts
 }
 
-/// The detections of every frame from the first to the last row's, in order (rows sorted by
-/// frame in `order`), with one empty frame standing for each gap in the frame numbers.
+/// The detections of every frame from the first to the last row's, in order (the frames of
+/// `frame_starts`), with one empty frame standing for each gap in the frame numbers.
 fn frame_inputs<'a>(
+    frame_starts: &'a [(i64, usize)],
     order: &'a [usize],
-    frame: ArrayView1<'a, i64>,
     x: ArrayView1<'a, f64>,
     y: ArrayView1<'a, f64>,
 ) -> impl Iterator<Item = Result<(FrameIndex, Vec<Detection>)>> + 'a {
-    let mut start = 0;
-    let mut previous: Option<i64> = None;
-    std::iter::from_fn(move || {
-        let &first = order.get(start)?;
-        let number = frame[first];
-        if let Some(p) = previous
-            && number > p + 1
-        {
-            previous = Some(p + 1);
-            return Some(Ok(((p + 1) as FrameIndex, Vec::new())));
-        }
-        let end = start + order[start..].partition_point(|&row| frame[row] == number);
-        let detections = order[start..end]
+    let (first, last) = match (frame_starts.first(), frame_starts.last()) {
+        (Some(&(first, _)), Some(&(last, _))) => (first, last),
+        _ => (0, -1),
+    };
+    let mut next = 0;
+    (first..=last).map(move |number| {
+        let rows = if frame_starts[next].0 == number {
+            next += 1;
+            rows_at(frame_starts, order, next - 1)
+        } else {
+            &[]
+        };
+        let detections = rows
             .iter()
             .map(|&row| Detection::new(Point2::new(x[row], y[row]), 1.0))
             .collect();
-        start = end;
-        previous = Some(number);
-        Some(Ok((number as FrameIndex, detections)))
+        Ok((number as FrameIndex, detections))
     })
 }
