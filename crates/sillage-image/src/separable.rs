@@ -2,11 +2,11 @@
 //! fused per tile so that the data stays in L1.
 //!
 //! The image is cut into bands of [`BAND_ROWS`] output rows (the unit of parallel work) and
-//! each band into strips of at most [`STRIP`] columns. For one strip the engine walks the
+//! each band into strips of at most [`strip_width`] columns. For one strip the engine walks the
 //! needed input rows once: it blurs each row segment horizontally with each kernel into a
 //! ring buffer of `2R+1` strip rows, and as soon as the ring holds the `2R+1` rows around an
 //! output row, blurs vertically from the ring into the output. A strip's rings hold
-//! `O(R · STRIP)` floats, a few tens of KiB that stay in L1, so the vertical pass — the one
+//! `O(R · strip)` floats, sized to stay in L1, so the vertical pass — the one
 //! that reads many rows per output — runs at L1 bandwidth; the image is read once and written
 //! once. Interior strips read the source rows in place; only the two border strips copy their
 //! row segments into a small padded buffer with the reflect-101 border. Bands run in parallel
@@ -30,9 +30,27 @@ use sillage_core::GrayImage;
 /// the thread count), though results would not depend on it anyway.
 const BAND_ROWS: usize = 256;
 
-/// Columns per strip: the two rings of a DoG at δ = 2 (17 rows each) then take 34 KiB, which
-/// fit in L1 together with the row segment being read.
-const STRIP: usize = 256;
+/// Widest strip, in columns.
+const MAX_STRIP: usize = 256;
+
+/// Strip widths are multiples of this: a whole number of the SIMD paths' register blocks
+/// (8 vectors of 16 lanes on AVX-512), whose remainder loop is slow.
+const STRIP_STEP: usize = 128;
+
+/// Bytes the rings of a strip may take, leaving room in a 32 KiB L1 for the row segment
+/// being read and the output row.
+const RING_BUDGET_BYTES: usize = 24 * 1024;
+
+/// Columns per strip for `combine`: the widest multiple of [`STRIP_STEP`] up to
+/// [`MAX_STRIP`] whose rings fit in [`RING_BUDGET_BYTES`] (never less than one step). The
+/// two 17-row rings of a DoG at δ = 2 take 34 KiB at 256 columns, more than L1 holds: 128
+/// columns ran that DoG with blob detection 1.06-1.39× faster (BENCHMARKS.md), while a
+/// single Gaussian of σ ≤ 2 keeps 256 columns, which were faster for it.
+fn strip_width(combine: &Combine<'_>) -> usize {
+    let ring_row_bytes = combine.kernel_count() * (2 * combine.radius() + 1) * 4;
+    let fitting = RING_BUDGET_BYTES / ring_row_bytes / STRIP_STEP * STRIP_STEP;
+    fitting.clamp(STRIP_STEP, MAX_STRIP)
+}
 
 /// Reflect-101 index (`… 2 1 | 0 1 2 … n-1 | n-2 n-3 …`, OpenCV's default border), repeated as
 /// often as needed so that kernels wider than the image stay defined; `n` must be ≥ 1.
@@ -78,7 +96,8 @@ impl Combine<'_> {
 /// Floats of scratch one band needs: a padded row segment and one ring per kernel.
 fn band_scratch_len(combine: &Combine<'_>) -> usize {
     let r = combine.radius();
-    (STRIP + 2 * r) + combine.kernel_count() * (2 * r + 1) * STRIP
+    let strip = strip_width(combine);
+    (strip + 2 * r) + combine.kernel_count() * (2 * r + 1) * strip
 }
 
 /// Filters `src` into `dst` (reshaped to the size of `src`) with `combine`, growing `scratch`
@@ -170,15 +189,16 @@ fn band<F: Fir>(
     let r = combine.radius();
     let slots = 2 * r + 1;
     let rows = out.len() / width;
-    let (pad, rings) = scratch.split_at_mut(STRIP + 2 * r);
-    let (ring_a, ring_b) = rings.split_at_mut(slots * STRIP);
+    let strip = strip_width(&combine);
+    let (pad, rings) = scratch.split_at_mut(strip + 2 * r);
+    let (ring_a, ring_b) = rings.split_at_mut(slots * strip);
     let (ka, kb) = match combine {
         Combine::Single(k) => (k, None),
         Combine::Difference(a, b) => (a, Some(b)),
     };
     let mut x0 = 0;
     while x0 < width {
-        let sw = STRIP.min(width - x0);
+        let sw = strip.min(width - x0);
         // Virtual rows v = y0 - r .. y0 + rows + r, stored in ring slot (v - (y0 - r)) % slots.
         let mut slot = 0;
         for i in 0..rows + 2 * r {

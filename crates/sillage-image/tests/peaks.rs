@@ -36,7 +36,7 @@ fn brute_force(image: &GrayImage, n: usize, threshold: f32) -> Vec<Peak> {
 proptest! {
     #[test]
     fn peaks_match_brute_force(
-        w in 1usize..40, h in 1usize..40, n in 1usize..4, levels in 2u32..6,
+        w in 1usize..70, h in 1usize..80, n in 1usize..4, levels in 2u32..6,
         threshold in -0.1f32..0.9, seed in any::<u64>(),
     ) {
         let mut image = random_image(w, h, seed);
