@@ -21,7 +21,24 @@ pub struct Peak {
 /// what a caller makes of it while its rows are still in cache ([`Self::find_map`]).
 #[derive(Debug, Clone)]
 pub struct PeakFinder<T = Peak> {
-    bands: Vec<Vec<T>>,
+    bands: Vec<Band<T>>,
+}
+
+/// One band's buffers: what it found, and the candidate masks of its current and previous
+/// rows (see [`scan_band`]).
+#[derive(Debug, Clone)]
+struct Band<T> {
+    found: Vec<T>,
+    masks: [Vec<u32>; 2],
+}
+
+impl<T> Default for Band<T> {
+    fn default() -> Self {
+        Self {
+            found: Vec::new(),
+            masks: [Vec::new(), Vec::new()],
+        }
+    }
 }
 
 impl<T> Default for PeakFinder<T> {
@@ -81,21 +98,21 @@ impl<T: Copy + Send> PeakFinder<T> {
         }
         let bands = (height - 2 * n).div_ceil(BAND_ROWS);
         if self.bands.len() < bands {
-            self.bands.resize_with(bands, Vec::new);
+            self.bands.resize_with(bands, Band::default);
         }
         self.bands[..bands]
             .par_iter_mut()
             .enumerate()
-            .for_each(|(band, found)| {
+            .for_each(|(band, Band { found, masks })| {
                 let y0 = n + band * BAND_ROWS;
                 let y1 = (y0 + BAND_ROWS).min(height - n);
                 found.clear();
-                scan_band_dispatch(image, y0..y1, n, threshold, &mut |peak| {
+                scan_band_dispatch(image, y0..y1, n, threshold, masks, &mut |peak| {
                     found.push(map(peak))
                 });
             });
         for band in &self.bands[..bands] {
-            out.extend_from_slice(band);
+            out.extend_from_slice(&band.found);
         }
     }
 }
@@ -110,17 +127,18 @@ fn scan_band_dispatch(
     ys: std::ops::Range<usize>,
     n: usize,
     threshold: f32,
+    masks: &mut [Vec<u32>; 2],
     emit: &mut impl FnMut(Peak),
 ) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, checked just above.
-            unsafe { scan_band_avx2(image, ys, n, threshold, emit) };
+            unsafe { scan_band_avx2(image, ys, n, threshold, masks, emit) };
             return;
         }
     }
-    scan_band(image, ys, n, threshold, emit);
+    scan_band(image, ys, n, threshold, masks, emit);
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -130,12 +148,14 @@ fn scan_band_avx2(
     ys: std::ops::Range<usize>,
     n: usize,
     threshold: f32,
+    masks: &mut [Vec<u32>; 2],
     emit: &mut impl FnMut(Peak),
 ) {
-    scan_band(image, ys, n, threshold, emit);
+    scan_band(image, ys, n, threshold, masks, emit);
 }
 
-/// Hands the peaks of rows `ys` to `emit`, in raster order (see [`PeakFinder::find`]).
+/// Hands the peaks of rows `ys` to `emit`, in raster order (see [`PeakFinder::find`]);
+/// `masks` is scratch, kept by the caller so that nothing is allocated per band.
 ///
 /// Candidates of a row are checked one row late, once the candidate masks of the next row
 /// have been computed: that streaming read has brought the row below into cache, where a
@@ -147,20 +167,21 @@ fn scan_band(
     ys: std::ops::Range<usize>,
     n: usize,
     threshold: f32,
+    masks: &mut [Vec<u32>; 2],
     emit: &mut impl FnMut(Peak),
 ) {
-    let (mut pending, mut masks) = (Vec::new(), Vec::new());
+    let [pending, current] = masks;
     let mut pending_y = None;
     for y in ys {
-        row_candidates(image.row(y), n, threshold, &mut masks);
+        row_candidates(image.row(y), n, threshold, current);
         if let Some(py) = pending_y {
-            check_candidates(image, py, n, &pending, emit);
+            check_candidates(image, py, n, pending, emit);
         }
-        std::mem::swap(&mut pending, &mut masks);
+        std::mem::swap(pending, current);
         pending_y = Some(y);
     }
     if let Some(py) = pending_y {
-        check_candidates(image, py, n, &pending, emit);
+        check_candidates(image, py, n, pending, emit);
     }
 }
 

@@ -44,8 +44,8 @@ const RING_BUDGET_BYTES: usize = 24 * 1024;
 /// Columns per strip for `combine`: the widest multiple of [`STRIP_STEP`] up to
 /// [`MAX_STRIP`] whose rings fit in [`RING_BUDGET_BYTES`] (never less than one step). The
 /// two 17-row rings of a DoG at δ = 2 take 34 KiB at 256 columns, more than L1 holds: 128
-/// columns ran that DoG with blob detection 1.06-1.39× faster (BENCHMARKS.md), while a
-/// single Gaussian of σ ≤ 2 keeps 256 columns, which were faster for it.
+/// columns ran that DoG 1.05-1.23× faster (BENCHMARKS.md), while a single Gaussian of
+/// σ ≤ 2 keeps 256 columns, which were faster for it.
 fn strip_width(combine: &Combine<'_>) -> usize {
     let ring_row_bytes = combine.kernel_count() * (2 * combine.radius() + 1) * 4;
     let fitting = RING_BUDGET_BYTES / ring_row_bytes / STRIP_STEP * STRIP_STEP;
