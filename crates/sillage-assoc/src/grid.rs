@@ -868,16 +868,30 @@ mod tests {
         assert_eq!(index.nearest(Point2::new(0.0, 0.0)), None);
     }
 
+    /// `n` points on a lattice of `columns` columns spaced `step`, each shifted by a
+    /// deterministic jitter in [0, 1), then `repeated` three times (exact duplicates).
+    fn jittered_lattice(
+        n: usize,
+        columns: usize,
+        step: (f64, f64),
+        repeated: Point2,
+    ) -> Vec<Point2> {
+        (0..n)
+            .map(|i| {
+                let j = (i * 7919 % 101) as f64 / 101.0;
+                Point2::new(
+                    (i % columns) as f64 * step.0 + j,
+                    (i / columns) as f64 * step.1 - j,
+                )
+            })
+            .chain([repeated; 3])
+            .collect()
+    }
+
     #[test]
     fn radius_queries_match_brute_force() {
         // A jittered lattice with repeated points, queried inside, on and outside the box.
-        let pts: Vec<_> = (0..400)
-            .map(|i| {
-                let j = (i * 7919 % 101) as f64 / 101.0;
-                Point2::new((i % 23) as f64 * 1.7 + j, (i / 23) as f64 * 2.3 - j)
-            })
-            .chain([Point2::new(5.0, 5.0); 3])
-            .collect();
+        let pts = jittered_lattice(400, 23, (1.7, 2.3), Point2::new(5.0, 5.0));
         let index = PointIndex::new(&pts);
         for q in 0..200 {
             let p = Point2::new(q as f64 * 0.31 - 8.0, (q * 37 % 60) as f64 - 5.0);
@@ -904,13 +918,7 @@ mod tests {
     fn near_queries_get_the_nearest_batch_answers() {
         // A jittered lattice with repeated points; queries on the points, slightly off
         // them, exactly between them (ties), scattered, and outside the box.
-        let pts: Vec<_> = (0..900)
-            .map(|i| {
-                let j = (i * 7919 % 101) as f64 / 101.0;
-                Point2::new((i % 30) as f64 * 3.0 + j, (i / 30) as f64 * 3.0 - j)
-            })
-            .chain([Point2::new(20.0, 20.0); 3])
-            .collect();
+        let pts = jittered_lattice(900, 30, (3.0, 3.0), Point2::new(20.0, 20.0));
         let index = PointIndex::new(&pts);
         let queries: Vec<_> = pts
             .iter()
