@@ -13,7 +13,7 @@
 //! from a Gaussian of the whole previous distribution.
 
 use serde::{Deserialize, Serialize};
-use sillage_core::{Error, Result, RngStream, TrackId, rng_stream};
+use sillage_core::{Error, Point2, Result, RngStream, TrackId, rng_stream};
 
 use crate::linalg::{Gaussian, Matrix};
 use crate::motion::kinematic::KinematicModel;
@@ -238,6 +238,31 @@ impl ImmParticleFilter {
         for i in 0..columns.mode.len() {
             let model = &models[usize::from(columns.mode[i])];
             model.advance(&mut columns, i, &mut normals);
+        }
+    }
+
+    /// Moves about `share` of the particles, evenly spread over the set, to positions drawn
+    /// from `N(centre, sd_px² I)`, keeping their velocity, acceleration, label and weight:
+    /// the observation-driven half of a mixture proposal (Okuma et al., "A boosted particle
+    /// filter", ECCV 2004), so that a filter whose prediction lags or drifts keeps
+    /// hypotheses on the person an observation shows. Call between [`Self::predict`] and
+    /// [`Self::weight`]; the likelihood then judges the moved particles like the others
+    /// (the proposal's importance ratio is not applied, as in Okuma et al.). A share ≤ 0
+    /// moves nothing.
+    pub fn propose_near(&mut self, share: f64, centre: Point2, sd_px: f64) {
+        if share.is_nan() || share <= 0.0 {
+            return;
+        }
+        let share = share.min(1.0);
+        let columns = self.particles.columns_mut();
+        let mut normals = Normals::new(&mut self.rng);
+        for i in 0..columns.pos_x.len() {
+            // Particle i is moved when the running count ⌊(i + 1)·share⌋ steps up.
+            if ((i + 1) as f64 * share).floor() > (i as f64 * share).floor() {
+                let (dx, dy) = normals.pair();
+                columns.pos_x[i] = centre.x + sd_px * dx;
+                columns.pos_y[i] = centre.y + sd_px * dy;
+            }
         }
     }
 
@@ -555,6 +580,31 @@ mod tests {
             assert!((share - 1.0 / 3.0).abs() < 0.01, "{w:?}");
         }
         assert_eq!(filter.particles().len(), 200);
+    }
+
+    #[test]
+    fn a_proposal_moves_its_share_of_particles_and_nothing_else() {
+        let spec = ImmPfSpec::new(&ImmPfParams::default(), 3, 9).unwrap();
+        let filter = spec.spawn(1, &spread(Point2::new(100.0, 100.0)));
+        let mut moved = filter.clone();
+        moved.propose_near(0.25, Point2::new(300.0, 50.0), 2.0);
+        let (before, after) = (filter.particles(), moved.particles());
+        let near = |i: usize| (after.pos_x()[i] - 300.0).hypot(after.pos_y()[i] - 50.0) < 10.0;
+        assert_eq!((0..200).filter(|&i| near(i)).count(), 50);
+        for i in 0..200 {
+            let kept =
+                after.pos_x()[i] == before.pos_x()[i] && after.pos_y()[i] == before.pos_y()[i];
+            assert!(
+                near(i) != kept,
+                "particle {i} both moved and kept, or neither"
+            );
+        }
+        assert_eq!(before.vel_x(), after.vel_x());
+        assert_eq!(before.modes(), after.modes());
+        assert_eq!(before.log_weights(), after.log_weights());
+        let mut untouched = filter.clone();
+        untouched.propose_near(0.0, Point2::new(300.0, 50.0), 2.0);
+        assert_eq!(untouched.particles().pos_x(), before.pos_x());
     }
 
     #[test]

@@ -20,17 +20,21 @@ const WALKERS: [Walker; 2] = [
     (280.0, 170.0, -2.0, [30, 170, 40], [220, 200, 40]),
 ];
 
-fn truth(frame: usize, k: usize) -> PersonBox {
+/// Walker `k`'s box at `frame`; from frame `turn_at` on, the walkers walk back the way they
+/// came.
+fn truth(frame: usize, k: usize, turn_at: usize) -> PersonBox {
     let (x, y, v, _, _) = WALKERS[k];
+    let out = frame.min(turn_at) as f64;
+    let back = frame.saturating_sub(turn_at) as f64;
     PersonBox::standing_on(
-        sillage_core::Point2::new(x + v * frame as f64, y),
+        sillage_core::Point2::new(x + v * (out - back), y),
         16.0,
         48.0,
     )
 }
 
 /// The frame's colour image, grey levels and foreground mask.
-fn render(frame: usize) -> (RgbImage, GrayImage, Image<bool>) {
+fn render(frame: usize, turn_at: usize) -> (RgbImage, GrayImage, Image<bool>) {
     let mut rgb = RgbImage::from_vec(W, H, vec![[110, 110, 110]; W * H]).unwrap();
     let mut mask = Image::from_vec(W, H, vec![false; W * H]).unwrap();
     // A textured ground, so that a box off the walker does not match it.
@@ -42,7 +46,7 @@ fn render(frame: usize) -> (RgbImage, GrayImage, Image<bool>) {
         }
     }
     for (k, walker) in WALKERS.iter().enumerate() {
-        let b = truth(frame, k);
+        let b = truth(frame, k, turn_at);
         for y in b.top_px.ceil() as usize..b.bottom_px().ceil() as usize {
             for x in b.left_px.ceil() as usize..b.right_px().ceil() as usize {
                 if x < W && y < H {
@@ -72,12 +76,15 @@ fn render(frame: usize) -> (RgbImage, GrayImage, Image<bool>) {
     (rgb, grey, mask)
 }
 
-fn run(
-    params: &PedestrianParams,
-    frames: usize,
-    images: bool,
-    seed: u64,
-) -> Vec<PedestrianEstimate> {
+/// Tracks the scene; `blobs_every_frame`: in image mode the walkers' boxes are candidates on
+/// every frame (as motion blobs are), not on frame 1 only.
+fn run(params: &PedestrianParams, scene: Scene, seed: u64) -> Vec<PedestrianEstimate> {
+    let Scene {
+        frames,
+        images,
+        turn_at,
+        blobs_every_frame,
+    } = scene;
     let mut tracker =
         PedestrianTracker::new(params, BoxSizing::FromCandidate, None, (W, H), seed).unwrap();
     let mut cues = FrameCues::default();
@@ -86,12 +93,12 @@ fn run(
     for frame in 0..frames {
         let candidates: Vec<Candidate> = (0..WALKERS.len())
             .map(|k| Candidate {
-                bbox: truth(frame, k),
+                bbox: truth(frame, k, turn_at),
                 score: 1.0,
             })
             .collect();
         let cues = if images {
-            let (rgb, grey, mask) = render(frame);
+            let (rgb, grey, mask) = render(frame, turn_at);
             cues.update(
                 &params.appearance,
                 &rgb,
@@ -109,8 +116,9 @@ fn run(
             frame: frame as u64,
             cues,
             // Image mode: the walkers are announced at frame 1 only (births need motion), then
-            // the likelihood alone follows them; detections only: every frame.
-            candidates: if images && frame != 1 {
+            // the likelihood alone follows them, unless blobs come every frame; detections
+            // only: every frame.
+            candidates: if images && frame != 1 && !blobs_every_frame {
                 &[]
             } else {
                 &candidates
@@ -121,14 +129,36 @@ fn run(
     out
 }
 
+/// What [`run`] tracks.
+#[derive(Clone, Copy)]
+struct Scene {
+    frames: usize,
+    images: bool,
+    /// Frame from which the walkers walk back (`usize::MAX`: never).
+    turn_at: usize,
+    blobs_every_frame: bool,
+}
+
+impl Scene {
+    /// Straight walkers, seen in images (blobs at frame 1 only) or as detections.
+    fn straight(frames: usize, images: bool) -> Self {
+        Self {
+            frames,
+            images,
+            turn_at: usize::MAX,
+            blobs_every_frame: false,
+        }
+    }
+}
+
 /// For each estimate, the walker it covers (IoU ≥ 0.5), and the largest foot error, px.
-fn check(estimates: &[PedestrianEstimate]) -> (Vec<(u64, usize)>, f64) {
+fn check(estimates: &[PedestrianEstimate], turn_at: usize) -> (Vec<(u64, usize)>, f64) {
     let mut pairs = Vec::new();
     let mut worst: f64 = 0.0;
     for e in estimates {
         let frame = e.frame as usize;
         let (k, iou) = (0..WALKERS.len())
-            .map(|k| (k, e.bbox.iou(&truth(frame, k))))
+            .map(|k| (k, e.bbox.iou(&truth(frame, k, turn_at))))
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap();
         assert!(
@@ -137,7 +167,7 @@ fn check(estimates: &[PedestrianEstimate]) -> (Vec<(u64, usize)>, f64) {
             e.track_id
         );
         pairs.push((e.track_id, k));
-        worst = worst.max((e.bbox.foot() - truth(frame, k).foot()).norm());
+        worst = worst.max((e.bbox.foot() - truth(frame, k, turn_at).foot()).norm());
     }
     pairs.sort_unstable();
     pairs.dedup();
@@ -156,8 +186,8 @@ fn colour_and_motion_follow_two_walkers_with_one_identity_each() {
     };
     // Every walker is born on frame 1 and never supported by a blob again.
     params.unsupported_frames = 1000;
-    let estimates = run(&params, 40, true, 3);
-    let (pairs, worst) = check(&estimates);
+    let estimates = run(&params, Scene::straight(40, true), 3);
+    let (pairs, worst) = check(&estimates, usize::MAX);
     assert_eq!(pairs, [(1, 0), (2, 1)], "one track per walker, no other");
     assert!(worst < 6.0, "largest foot error {worst:.2} px");
     let last = estimates.iter().filter(|e| e.frame == 39).count();
@@ -175,12 +205,13 @@ fn colour_and_motion_follow_two_walkers_with_one_identity_each() {
 #[test]
 fn detections_alone_keep_identities_and_runs_repeat_with_the_seed() {
     let params = PedestrianParams::default();
-    let estimates = run(&params, 30, false, 5);
-    let (pairs, worst) = check(&estimates);
+    let scene = Scene::straight(30, false);
+    let estimates = run(&params, scene, 5);
+    let (pairs, worst) = check(&estimates, usize::MAX);
     assert_eq!(pairs, [(1, 0), (2, 1)]);
     assert!(worst < 4.0, "largest foot error {worst:.2} px");
-    assert_eq!(estimates, run(&params, 30, false, 5));
-    assert_ne!(estimates, run(&params, 30, false, 6));
+    assert_eq!(estimates, run(&params, scene, 5));
+    assert_ne!(estimates, run(&params, scene, 6));
 }
 
 #[test]
@@ -210,6 +241,12 @@ fn frames_out_of_order_and_bad_parameters_are_refused() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("birth_overlap"), "{err}");
+    let mut bad = PedestrianParams::default();
+    bad.proposal.share = f64::NAN;
+    let err = PedestrianTracker::new(&bad, BoxSizing::FromCandidate, None, (W, H), 1)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("proposal.share"), "{err}");
     let mp = PedestrianParams {
         models: vec![ModelName::Mp],
         ..Default::default()
@@ -218,4 +255,52 @@ fn frames_out_of_order_and_bad_parameters_are_refused() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("motion prior"), "{err}");
+}
+
+/// Mean foot error, px, of the estimates of frames `from..`, each against the walker it
+/// covers.
+fn mean_foot_error(estimates: &[PedestrianEstimate], from: usize, turn_at: usize) -> f64 {
+    let errors: Vec<f64> = estimates
+        .iter()
+        .filter(|e| e.frame as usize >= from)
+        .map(|e| {
+            let frame = e.frame as usize;
+            (0..WALKERS.len())
+                .map(|k| (e.bbox.foot() - truth(frame, k, turn_at).foot()).norm())
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect();
+    errors.iter().sum::<f64>() / errors.len().max(1) as f64
+}
+
+#[test]
+fn blob_proposals_keep_boxes_on_walkers_that_turn_back() {
+    let scene = Scene {
+        frames: 30,
+        images: true,
+        turn_at: 15,
+        blobs_every_frame: true,
+    };
+    // The box lags behind a walker that turns until the velocity particles catch up; blob
+    // proposals put hypotheses where the walker is at once.
+    let with = PedestrianParams::default();
+    let mut without = with.clone();
+    without.proposal.share = 0.0;
+    let (mut sum_with, mut sum_without) = (0.0, 0.0);
+    for seed in 1..=6 {
+        let e_with = mean_foot_error(&run(&with, scene, seed), 15, 15);
+        let e_without = mean_foot_error(&run(&without, scene, seed), 15, 15);
+        assert!(
+            e_with <= 1.1 * e_without,
+            "seed {seed}: {e_with:.2} px with proposals, {e_without:.2} px without"
+        );
+        sum_with += e_with;
+        sum_without += e_without;
+    }
+    assert!(
+        sum_with < 0.7 * sum_without,
+        "mean foot error after the turn: {:.2} px with proposals, {:.2} px without",
+        sum_with / 6.0,
+        sum_without / 6.0
+    );
 }

@@ -19,7 +19,7 @@ mod tracker;
 
 pub use appearance::{Appearance, AppearanceParams, FrameCues, HistogramScratch};
 pub use models::PedestrianMotion;
-pub use params::{DetectionLikelihoodParams, ModelName, PedestrianParams};
+pub use params::{DetectionLikelihoodParams, ModelName, PedestrianParams, ProposalParams};
 pub use person_box::PersonBox;
 pub use sizing::BoxSizing;
 pub use tracker::{Candidate, PedestrianEstimate, PedestrianFrame, PedestrianTracker};

@@ -111,6 +111,29 @@ impl Default for DetectionLikelihoodParams {
     }
 }
 
+/// The blob-driven proposal of the image mode (not in the paper): a share of the particles of
+/// each tracker that a motion blob's person overlaps is moved onto that person's foot point
+/// before weighting.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProposalParams {
+    /// Share of a matched tracker's particles moved; default 0.2. 0 gives the
+    /// paper's filter, whose particles follow their motion models only.
+    pub share: f64,
+    /// Least IoU between a tracker's predicted box and a blob's person for the person to
+    /// draw the tracker's particles (greedy one-to-one matching); default 0.3.
+    pub min_iou: f64,
+}
+
+impl Default for ProposalParams {
+    fn default() -> Self {
+        Self {
+            share: 0.2,
+            min_iou: 0.3,
+        }
+    }
+}
+
 /// Parameters of the pedestrian tracker: the filter, the competing models and their
 /// noises, the observation model and the life cycle of trackers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -134,6 +157,8 @@ pub struct PedestrianParams {
     pub appearance: AppearanceParams,
     /// The detection likelihood (detections only).
     pub detection: DetectionLikelihoodParams,
+    /// The blob-driven proposal (images only).
+    pub proposal: ProposalParams,
     /// A tracker dies after its mean particle likelihood stays below `exp` of this for
     /// `death_frames` frames (§5.3); default −14 (chosen on PETS 2009 S2.L1 among −14 to −26,
     /// docs/immpf.md; a person well followed scores −2 to −8, a box that lost its person
@@ -182,6 +207,7 @@ impl Default for PedestrianParams {
             init_vel_noise_px_per_frame: 2.0,
             appearance: AppearanceParams::default(),
             detection: DetectionLikelihoodParams::default(),
+            proposal: ProposalParams::default(),
             death_log_likelihood: -14.0,
             death_frames: 3,
             unsupported_frames: 7,
@@ -228,6 +254,8 @@ impl PedestrianParams {
             ("duplicate_overlap", self.duplicate_overlap),
             ("detection.match_iou", self.detection.match_iou),
             ("detection.size_smoothing", self.detection.size_smoothing),
+            ("proposal.share", self.proposal.share),
+            ("proposal.min_iou", self.proposal.min_iou),
         ] {
             if !(0.0..=1.0).contains(&value) {
                 return Err(Error::parameter(key, value, "must be in [0, 1]"));

@@ -198,6 +198,8 @@ impl PedestrianTracker {
             .for_each(|track| track.filter.predict(models));
         if cues.is_none() {
             self.match_detections(candidates);
+        } else {
+            self.propose_on_blobs(candidates);
         }
         let (params, sizing) = (&self.params, &self.sizing);
         let death = params.death_log_likelihood.exp();
@@ -239,32 +241,12 @@ impl PedestrianTracker {
     /// overlaps most (greedy by IoU, at least `match_iou`); a matched tracker's size follows
     /// its detections.
     fn match_detections(&mut self, candidates: &[Candidate]) {
-        let predicted: Vec<PersonBox> = self
-            .tracks
-            .iter()
-            .map(|t| self.sizing.box_at(estimate_foot(&t.filter), t.size_px))
-            .collect();
-        let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-        for (t, p) in predicted.iter().enumerate() {
-            for (d, c) in candidates.iter().enumerate() {
-                let iou = p.iou(&c.bbox);
-                if iou >= self.params.detection.match_iou {
-                    pairs.push((iou, t, d));
-                }
-            }
-        }
-        pairs.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-        let mut track_used = vec![false; self.tracks.len()];
-        let mut detection_used = vec![false; candidates.len()];
+        let boxes: Vec<PersonBox> = candidates.iter().map(|c| c.bbox).collect();
+        let pairs = self.match_predicted(&boxes, self.params.detection.match_iou);
         self.tracks.iter_mut().for_each(|t| t.matched = None);
         let alpha = self.params.detection.size_smoothing;
-        for (_, t, d) in pairs {
-            if track_used[t] || detection_used[d] {
-                continue;
-            }
-            track_used[t] = true;
-            detection_used[d] = true;
-            let detection = candidates[d].bbox;
+        for (t, d) in pairs {
+            let detection = boxes[d];
             let track = &mut self.tracks[t];
             track.matched = Some(detection);
             track.size_px = (
@@ -272,6 +254,59 @@ impl PedestrianTracker {
                 (1.0 - alpha) * track.size_px.1 + alpha * detection.height_px,
             );
         }
+    }
+
+    /// Image mode: the motion blobs' people (`BoxSizing::people_in`) matched to the trackers
+    /// as detections are ([`Self::match_predicted`], IoU ≥ `proposal.min_iou`), and a share
+    /// of each matched tracker's particles moved onto its person's foot point
+    /// (`ImmParticleFilter::propose_near`, σ = `init_pos_noise_px`). Not in the paper, whose
+    /// particles follow their motion models only: there a box that lags behind a walker or
+    /// slides off a person of uniform colour has no hypothesis left on the person.
+    fn propose_on_blobs(&mut self, candidates: &[Candidate]) {
+        let share = self.params.proposal.share;
+        if share <= 0.0 || self.tracks.is_empty() {
+            return;
+        }
+        let people: Vec<PersonBox> = candidates
+            .iter()
+            .flat_map(|c| self.sizing.people_in(&c.bbox))
+            .collect();
+        let sd = self.params.init_pos_noise_px;
+        for (t, p) in self.match_predicted(&people, self.params.proposal.min_iou) {
+            self.tracks[t]
+                .filter
+                .propose_near(share, people[p].foot(), sd);
+        }
+    }
+
+    /// Greedy one-to-one matching of the trackers' predicted boxes (on their posterior mean
+    /// foot point) to `boxes`, best IoU first, pairs of IoU ≥ `min_iou` only; ties go to the
+    /// lower tracker, then box, index. Returns (tracker, box) pairs.
+    fn match_predicted(&self, boxes: &[PersonBox], min_iou: f64) -> Vec<(usize, usize)> {
+        let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+        for (t, track) in self.tracks.iter().enumerate() {
+            let predicted = self
+                .sizing
+                .box_at(estimate_foot(&track.filter), track.size_px);
+            for (d, b) in boxes.iter().enumerate() {
+                let iou = predicted.iou(b);
+                if iou >= min_iou {
+                    pairs.push((iou, t, d));
+                }
+            }
+        }
+        pairs.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+        let mut track_used = vec![false; self.tracks.len()];
+        let mut box_used = vec![false; boxes.len()];
+        let mut matches = Vec::new();
+        for (_, t, d) in pairs {
+            if !track_used[t] && !box_used[d] {
+                track_used[t] = true;
+                box_used[d] = true;
+                matches.push((t, d));
+            }
+        }
+        matches
     }
 
     /// Counts the frames in a row where no candidate (motion blob or detection) holds a
