@@ -137,6 +137,18 @@ impl FrameCues {
     }
 }
 
+impl FrameCues {
+    /// The share of `b`'s pixels that the foreground mask marks; `None` without a mask or
+    /// when `b` holds no pixel.
+    pub(crate) fn foreground_share(&self, b: &PersonBox) -> Option<f64> {
+        if self.has_foreground {
+            self.foreground.share(b)
+        } else {
+            None
+        }
+    }
+}
+
 /// The reference histograms of one person, taken at its tracker's birth.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Appearance {

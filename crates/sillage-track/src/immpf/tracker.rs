@@ -404,7 +404,9 @@ impl PedestrianTracker {
                         match Appearance::capture(&self.params.appearance, cues, &person) {
                             Some(appearance)
                                 if appearance.moving_share().unwrap_or(0.0)
-                                    >= self.params.birth_min_motion =>
+                                    >= self.params.birth_min_motion
+                                    && cues.foreground_share(&person).unwrap_or(1.0)
+                                        >= self.params.birth_min_foreground =>
                             {
                                 Some(appearance)
                             }
