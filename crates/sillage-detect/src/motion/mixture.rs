@@ -175,7 +175,8 @@ impl MixtureBackground {
             )));
         }
         labels.reshape(self.width, self.height);
-        // α = 1/(t + 1) while t < history: a running mean that settles into α = 1/history.
+        // α = 1/(t + 1) during the start-up (a running mean, never below 1/history), then
+        // α = 1/history.
         let alpha = if self.frames < self.params.bootstrap_frames as u64 {
             1.0 / (self.frames + 1).min(self.params.history as u64) as f32
         } else {

@@ -135,9 +135,7 @@ impl FrameCues {
         }
         Ok(())
     }
-}
 
-impl FrameCues {
     /// The share of `b`'s pixels that the foreground mask marks; `None` without a mask or
     /// when `b` holds no pixel.
     pub(crate) fn foreground_share(&self, b: &PersonBox) -> Option<f64> {
