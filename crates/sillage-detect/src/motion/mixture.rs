@@ -338,6 +338,26 @@ mod tests {
         assert_eq!(foreground, 100);
     }
 
+    /// Frames of an object parked at frame `warm_frames` (grey 0.8 on a static 0.2 scene)
+    /// until its pixels join the background; 400 if they never do.
+    fn frames_to_absorb(params: &MixtureParams, warm_frames: usize) -> usize {
+        let (w, h) = (4, 4);
+        let mut model = MixtureBackground::new(params, w, h).unwrap();
+        let mut labels = Image::new(w, h);
+        for _ in 0..warm_frames {
+            model.apply(&frame(w, h, |_, _| 0.2), &mut labels).unwrap();
+        }
+        let parked = frame(w, h, |_, _| 0.8);
+        let mut frames = 0;
+        loop {
+            model.apply(&parked, &mut labels).unwrap();
+            frames += 1;
+            if labels.get(0, 0) == BACKGROUND || frames == 400 {
+                return frames;
+            }
+        }
+    }
+
     #[test]
     fn an_object_that_stays_is_learnt_into_the_background() {
         let params = MixtureParams {
@@ -345,53 +365,24 @@ mod tests {
             background_ratio: 0.7,
             ..MixtureParams::default()
         };
-        let (w, h) = (10, 10);
-        let mut model = MixtureBackground::new(&params, w, h).unwrap();
-        let mut labels = Image::new(w, h);
-        for _ in 0..30 {
-            model.apply(&frame(w, h, |_, _| 0.2), &mut labels).unwrap();
-        }
-        let parked = frame(w, h, |x, _| if x < 5 { 0.8 } else { 0.2 });
-        model.apply(&parked, &mut labels).unwrap();
-        assert_eq!(labels.get(0, 0), FOREGROUND);
-        let mut frames_to_absorb = 1;
-        while labels.get(0, 0) != BACKGROUND {
-            model.apply(&parked, &mut labels).unwrap();
-            frames_to_absorb += 1;
-            assert!(frames_to_absorb < 40, "never absorbed");
-        }
+        let frames = frames_to_absorb(&params, 30);
         // The new Gaussian joins the background once the old one's weight (1 − α)^n falls
         // below T: n = ln T / ln(1 − α) ≈ 7 frames at α = 1/20, T = 0.7.
-        assert!((6..10).contains(&frames_to_absorb), "{frames_to_absorb}");
+        assert!((6..10).contains(&frames), "{frames}");
     }
 
     #[test]
     fn a_short_start_up_keeps_a_stopped_object_in_the_foreground_longer() {
-        // Frames until an object that stops at frame 30 joins the background.
-        let frames_to_absorb = |bootstrap_frames: usize| {
+        let absorbed_after = |bootstrap_frames: usize| {
             let params = MixtureParams {
                 bootstrap_frames,
                 ..MixtureParams::default()
             };
-            let (w, h) = (4, 4);
-            let mut model = MixtureBackground::new(&params, w, h).unwrap();
-            let mut labels = Image::new(w, h);
-            for _ in 0..30 {
-                model.apply(&frame(w, h, |_, _| 0.2), &mut labels).unwrap();
-            }
-            let parked = frame(w, h, |_, _| 0.8);
-            let mut frames = 0;
-            loop {
-                model.apply(&parked, &mut labels).unwrap();
-                frames += 1;
-                if labels.get(0, 0) == BACKGROUND || frames == 400 {
-                    return frames;
-                }
-            }
+            frames_to_absorb(&params, 30)
         };
         // Running mean from frame 30: the old Gaussian's weight 30/(30 + n) falls below
         // T = 0.6 after n = 21 frames; at α = 1/200, (1 − α)^n after n = 102.
-        let (long, short) = (frames_to_absorb(200), frames_to_absorb(10));
+        let (long, short) = (absorbed_after(200), absorbed_after(10));
         assert!((18..25).contains(&long), "{long}");
         assert!((95..110).contains(&short), "{short}");
     }
