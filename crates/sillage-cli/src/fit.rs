@@ -253,6 +253,10 @@ fn human_summary(args: &FitBedloadArgs, fit: &BedloadFit, tracks: usize) -> Stri
 /// Writes `text` to a temporary file beside `path`, then renames it over `path`, so a reader
 /// never sees a half-written config.
 pub(crate) fn write_atomically(path: &Path, text: &str) -> Result<()> {
+    if sillage::io::writes_in_place(path) {
+        return std::fs::write(path, text)
+            .with_context(|| format!("cannot write {}", path.display()));
+    }
     let name = path
         .file_name()
         .ok_or_else(|| anyhow!("{}: --out must name a file", path.display()))?;

@@ -236,7 +236,12 @@ struct ModelWeightsWriter {
 
 impl ModelWeightsWriter {
     fn create(path: &Path, models: &[ModelName]) -> Result<Self> {
-        let temporary = path.with_extension("partial");
+        // A device or pipe (`/dev/null`) is written in place: a rename would replace it.
+        let temporary = if sillage::io::writes_in_place(path) {
+            path.to_path_buf()
+        } else {
+            path.with_extension("partial")
+        };
         let file = std::fs::File::create(&temporary)
             .with_context(|| format!("cannot create {}", temporary.display()))?;
         let mut out = std::io::BufWriter::new(file);
@@ -263,6 +268,9 @@ impl ModelWeightsWriter {
     fn finish(mut self) -> Result<()> {
         self.out.flush()?;
         drop(self.out);
+        if self.temporary == self.path {
+            return Ok(());
+        }
         std::fs::rename(&self.temporary, &self.path)
             .with_context(|| format!("cannot write {}", self.path.display()))
     }

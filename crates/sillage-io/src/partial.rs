@@ -1,5 +1,6 @@
 //! Files written under a temporary name (`.NAME.partial`) in the destination folder and
 //! renamed on success, so a reader never sees a half-written file under the final name.
+//! Outputs that are not regular files (`/dev/null`, a named pipe) are written in place.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -16,13 +17,26 @@ pub(crate) struct PartialFile {
     final_path: PathBuf,
     partial_path: PathBuf,
     writer: BufWriter<File>,
+    /// Written straight to `final_path` ([`writes_in_place`]): nothing to rename or remove.
+    in_place: bool,
 }
 
 impl PartialFile {
-    /// Creates (or truncates) `.NAME.partial` in the folder of `path`.
+    /// Creates (or truncates) `.NAME.partial` in the folder of `path`; opens `path` itself
+    /// when it is not a regular file ([`writes_in_place`]).
     pub(crate) fn create(path: &Path) -> Result<Self> {
-        let partial_path = partial_path(path)?;
-        let file = File::create(&partial_path).map_err(|e| Error::Io {
+        let in_place = writes_in_place(path);
+        let partial_path = if in_place {
+            path.to_path_buf()
+        } else {
+            partial_path(path)?
+        };
+        let opened = if in_place {
+            File::options().write(true).open(&partial_path)
+        } else {
+            File::create(&partial_path)
+        };
+        let file = opened.map_err(|e| Error::Io {
             path: partial_path.clone(),
             cause: e,
             hint: "check that the output folder exists and is writable".into(),
@@ -31,6 +45,7 @@ impl PartialFile {
             final_path: path.to_path_buf(),
             partial_path,
             writer: BufWriter::new(file),
+            in_place,
         })
     }
 
@@ -52,6 +67,7 @@ impl PartialFile {
             final_path,
             partial_path,
             writer,
+            in_place,
         } = self;
         // Flushed but not fsync'ed: the rename guards against interrupted runs, and an fsync
         // per synthetic frame would dominate the cost of writing long sequences.
@@ -59,7 +75,9 @@ impl PartialFile {
             .into_inner()
             .map_err(|e| Error::io(&partial_path, e.into_error()))?;
         drop(file);
-        std::fs::rename(&partial_path, &final_path).map_err(|e| Error::io(&final_path, e))?;
+        if !in_place {
+            std::fs::rename(&partial_path, &final_path).map_err(|e| Error::io(&final_path, e))?;
+        }
         Ok(final_path)
     }
 
@@ -68,11 +86,14 @@ impl PartialFile {
         let Self {
             partial_path,
             writer,
+            in_place,
             ..
         } = self;
         drop(writer);
-        // Best effort: the original error is what the caller reports.
-        let _ = std::fs::remove_file(partial_path);
+        if !in_place {
+            // Best effort: the original error is what the caller reports.
+            let _ = std::fs::remove_file(partial_path);
+        }
     }
 }
 
@@ -85,6 +106,14 @@ impl Write for PartialFile {
     fn flush(&mut self) -> std::io::Result<()> {
         self.writer.flush()
     }
+}
+
+/// True when `path` names an existing file that is not a regular one (`/dev/null`, a named
+/// pipe, a terminal): such an output is written in place, since renaming a temporary file
+/// over it would replace the device or pipe with a regular file (for root, `/dev/null`
+/// itself).
+pub fn writes_in_place(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// `.NAME.partial` in the folder of `path`.
@@ -117,5 +146,25 @@ mod tests {
         assert_eq!(file.commit().unwrap(), path);
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "row\n");
         assert!(!partial.exists());
+    }
+
+    #[test]
+    fn dev_null_is_written_in_place_and_stays_a_device() {
+        let null = Path::new("/dev/null");
+        if !null.exists() {
+            return;
+        }
+        assert!(writes_in_place(null));
+        let mut file = PartialFile::create(null).unwrap();
+        file.write_all(b"row\n").unwrap();
+        assert_eq!(file.partial_path(), null);
+        assert_eq!(file.commit().unwrap(), null);
+        let metadata = std::fs::metadata(null).unwrap();
+        assert!(!metadata.is_file(), "/dev/null became a regular file");
+        assert!(!writes_in_place(&std::env::temp_dir()));
+        let dir = tempfile::tempdir().unwrap();
+        let regular = dir.path().join("out.txt");
+        std::fs::write(&regular, "old").unwrap();
+        assert!(!writes_in_place(&regular));
     }
 }

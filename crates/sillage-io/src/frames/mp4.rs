@@ -11,7 +11,7 @@ use sillage_core::{Error, Result, RgbImage};
 
 use super::video::missing_program;
 use crate::WrittenSummary;
-use crate::partial::partial_path;
+use crate::partial::{partial_path, writes_in_place};
 
 /// A running `ffmpeg` encoding the frames it is given into an MP4.
 #[derive(Debug)]
@@ -56,7 +56,12 @@ impl Mp4Writer {
         } else {
             "mpeg4"
         };
-        let partial_path = partial_path(path)?;
+        // A device or pipe (`/dev/null`) is written in place: a rename would replace it.
+        let partial_path = if writes_in_place(path) {
+            path.to_path_buf()
+        } else {
+            partial_path(path)?
+        };
         let mut child = Command::new(ffmpeg)
             .args([
                 "-y", "-v", "error", "-nostdin", "-f", "rawvideo", "-pix_fmt", "rgb24",
@@ -156,8 +161,10 @@ impl Mp4Writer {
                 said.trim()
             )));
         }
-        std::fs::rename(&self.partial_path, &self.final_path)
-            .map_err(|e| Error::io(&self.final_path, e))?;
+        if self.partial_path != self.final_path {
+            std::fs::rename(&self.partial_path, &self.final_path)
+                .map_err(|e| Error::io(&self.final_path, e))?;
+        }
         self.finished = true;
         Ok(WrittenSummary {
             rows: self.frames,
@@ -184,7 +191,9 @@ impl Drop for Mp4Writer {
             // Abandoned (an error upstream): no ffmpeg left running, no partial file kept.
             let _ = self.child.kill();
             let _ = self.child.wait();
-            let _ = std::fs::remove_file(&self.partial_path);
+            if self.partial_path != self.final_path {
+                let _ = std::fs::remove_file(&self.partial_path);
+            }
         }
     }
 }

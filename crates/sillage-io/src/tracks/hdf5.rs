@@ -15,7 +15,7 @@ use sillage_core::{Error, MotionState, Result, TrackPoint, TrackSink};
 use super::column_buffer::TrackColumns;
 use super::columns::{STATE_COLUMNS, TRACK_COLUMNS, TrackLayout};
 use super::{TrackFileHeader, TrackWriter, WrittenSummary};
-use crate::partial::partial_path;
+use crate::partial::{partial_path, writes_in_place};
 
 /// Rows buffered before the datasets are extended.
 const CHUNK_ROWS: usize = 65_536;
@@ -50,6 +50,13 @@ impl Hdf5TrackWriter {
     /// Creates `.NAME.partial` beside `path` with empty resizable datasets and the header
     /// attributes.
     pub(crate) fn create(path: &Path, header: &TrackFileHeader) -> Result<Self> {
+        if writes_in_place(path) {
+            return Err(Error::input(format!(
+                "{}: an HDF5 file needs a regular file path (not a device or a pipe); give \
+                 e.g. `tracks.h5`",
+                path.display()
+            )));
+        }
         let partial = partial_path(path)?;
         let error = |action: &str, e: hdf5::Error| hdf5_error(&partial, action, e);
         let file = hdf5::File::create(&partial).map_err(|e| error("create", e))?;
