@@ -5,10 +5,9 @@
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use sillage::core::{MotionState, Vec2};
 use sillage::filter::fit::STATE_NAMES;
@@ -68,7 +67,7 @@ pub fn run_bedload(args: &FitBedloadArgs) -> Result<()> {
         )
     })?;
     let text = config_text(args, &fit, tracks.len(), tracks_without_state)?;
-    write_atomically(&args.out, &text)?;
+    write_config(&args.out, &text)?;
     if args.json {
         let summary = JsonSummary {
             truth: &args.truth,
@@ -250,38 +249,13 @@ fn human_summary(args: &FitBedloadArgs, fit: &BedloadFit, tracks: usize) -> Stri
     s
 }
 
-/// Writes `text` to a temporary file beside `path`, then renames it over `path`, so a reader
-/// never sees a half-written config.
-pub(crate) fn write_atomically(path: &Path, text: &str) -> Result<()> {
-    if sillage::io::writes_in_place(path) {
-        return std::fs::write(path, text)
-            .with_context(|| format!("cannot write {}", path.display()));
-    }
-    let name = path
-        .file_name()
-        .ok_or_else(|| anyhow!("{}: --out must name a file", path.display()))?;
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let temporary = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let written = std::fs::File::create(&temporary)
-        .and_then(|mut file| {
-            file.write_all(text.as_bytes())?;
-            file.sync_all()
-        })
-        .and_then(|()| std::fs::rename(&temporary, path));
-    if let Err(error) = written {
-        let _ = std::fs::remove_file(&temporary);
-        bail!(
-            "{}: cannot write the config ({error}); check that its folder exists and is \
-             writable",
+/// Writes a config with `sillage_io::write_text` (a partial file renamed when complete),
+/// naming the final path on error.
+pub(crate) fn write_config(path: &Path, text: &str) -> Result<()> {
+    sillage::io::write_text(path, text).with_context(|| {
+        format!(
+            "{}: cannot write the config; check that its folder exists and is writable",
             path.display()
-        );
-    }
-    Ok(())
+        )
+    })
 }

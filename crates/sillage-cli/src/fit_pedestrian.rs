@@ -19,7 +19,7 @@ use sillage::filter::{MotionPrior, MotionPriorParams};
 use sillage::io::{MotFileRole, MotRow, read_mot_rows, read_mot_sequence};
 
 use crate::cli::{FitHomographyArgs, FitMotionPriorArgs};
-use crate::fit::write_atomically;
+use crate::fit::write_config;
 use crate::ground_plane::{FitTable, GroundPlaneFile};
 
 /// One trajectory: its foot points by frame.
@@ -204,7 +204,7 @@ pub fn run_homography(args: &FitHomographyArgs) -> Result<()> {
     }
     text.push('\n');
     text.push_str(&toml::to_string(&file).context("cannot write the homography as TOML")?);
-    write_atomically(&args.out, &text)?;
+    write_config(&args.out, &text)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&file)?);
     } else {

@@ -3,14 +3,14 @@
 //! writes MOTChallenge results and, with `--model-weights`, the model weights πₘ per row.
 
 use std::io::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result, ensure};
 use serde::{Deserialize, Serialize};
 use sillage::detect::motion::MotionParams;
 use sillage::filter::MotionPrior;
-use sillage::io::{MotResultsWriter, MotRow};
+use sillage::io::{MotResultsWriter, MotRow, PartialFile};
 use sillage::toml_config::{read_toml_file, set_key};
 use sillage::track::immpf::{
     BoxSizing, ModelName, PedestrianEstimate, PedestrianFrame, PedestrianParams, PedestrianTracker,
@@ -227,31 +227,17 @@ pub fn mot_rows(estimates: &[PedestrianEstimate]) -> Vec<MotRow> {
 }
 
 /// `--model-weights FILE`: `frame,id,<model>...` with πₘ per row (1-based frames), written to
-/// a temporary file renamed at the end.
+/// a partial file renamed at the end.
 struct ModelWeightsWriter {
-    path: PathBuf,
-    temporary: PathBuf,
-    out: std::io::BufWriter<std::fs::File>,
+    out: PartialFile,
 }
 
 impl ModelWeightsWriter {
     fn create(path: &Path, models: &[ModelName]) -> Result<Self> {
-        // A device or pipe (`/dev/null`) is written in place: a rename would replace it.
-        let temporary = if sillage::io::writes_in_place(path) {
-            path.to_path_buf()
-        } else {
-            path.with_extension("partial")
-        };
-        let file = std::fs::File::create(&temporary)
-            .with_context(|| format!("cannot create {}", temporary.display()))?;
-        let mut out = std::io::BufWriter::new(file);
+        let mut out = PartialFile::create(path)?;
         let header: Vec<&str> = models.iter().map(|m| m.label()).collect();
         writeln!(out, "frame,id,{}", header.join(","))?;
-        Ok(Self {
-            path: path.to_path_buf(),
-            temporary,
-            out,
-        })
+        Ok(Self { out })
     }
 
     fn push(&mut self, estimates: &[PedestrianEstimate]) -> Result<()> {
@@ -265,13 +251,8 @@ impl ModelWeightsWriter {
         Ok(())
     }
 
-    fn finish(mut self) -> Result<()> {
-        self.out.flush()?;
-        drop(self.out);
-        if self.temporary == self.path {
-            return Ok(());
-        }
-        std::fs::rename(&self.temporary, &self.path)
-            .with_context(|| format!("cannot write {}", self.path.display()))
+    fn finish(self) -> Result<()> {
+        self.out.commit()?;
+        Ok(())
     }
 }

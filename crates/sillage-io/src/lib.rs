@@ -93,7 +93,7 @@ pub use mot::{
 };
 pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
 pub use numeric_table::{ColumnValues, NumericFormat, NumericTable, write_numeric_table};
-pub use partial::writes_in_place;
+pub use partial::PartialFile;
 pub use tracks::{
     STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackLayout,
     TrackTable, TrackWriter, WrittenSummary, create_track_writer, for_each_track_point,

@@ -8,35 +8,24 @@ use std::path::{Path, PathBuf};
 
 use sillage_core::{Error, Result};
 
-/// A file being written as `.NAME.partial` beside its final `path`.
+/// A file being written as `.NAME.partial` beside its final `path` (or, for a device or a
+/// pipe, into `path` itself: [`writes_in_place`]).
 ///
 /// Dropping it without [`PartialFile::commit`] leaves the partial file in place: after an
 /// interrupted run it holds every row written so far.
 #[derive(Debug)]
-pub(crate) struct PartialFile {
+pub struct PartialFile {
     final_path: PathBuf,
     partial_path: PathBuf,
     writer: BufWriter<File>,
-    /// Written straight to `final_path` ([`writes_in_place`]): nothing to rename or remove.
-    in_place: bool,
 }
 
 impl PartialFile {
-    /// Creates (or truncates) `.NAME.partial` in the folder of `path`; opens `path` itself
-    /// when it is not a regular file ([`writes_in_place`]).
-    pub(crate) fn create(path: &Path) -> Result<Self> {
-        let in_place = writes_in_place(path);
-        let partial_path = if in_place {
-            path.to_path_buf()
-        } else {
-            partial_path(path)?
-        };
-        let opened = if in_place {
-            File::options().write(true).open(&partial_path)
-        } else {
-            File::create(&partial_path)
-        };
-        let file = opened.map_err(|e| Error::Io {
+    /// Creates (or truncates) `.NAME.partial` in the folder of `path`, or opens `path`
+    /// itself when it is not a regular file.
+    pub fn create(path: &Path) -> Result<Self> {
+        let partial_path = write_target(path)?;
+        let file = File::create(&partial_path).map_err(|e| Error::Io {
             path: partial_path.clone(),
             cause: e,
             hint: "check that the output folder exists and is writable".into(),
@@ -45,29 +34,27 @@ impl PartialFile {
             final_path: path.to_path_buf(),
             partial_path,
             writer: BufWriter::new(file),
-            in_place,
         })
     }
 
     /// The temporary path being written.
-    pub(crate) fn partial_path(&self) -> &Path {
+    pub fn partial_path(&self) -> &Path {
         &self.partial_path
     }
 
     /// Writes `bytes` whole, naming the partial file on error.
-    pub(crate) fn write_all(&mut self, bytes: &[u8]) -> Result<()> {
+    pub fn write_all(&mut self, bytes: &[u8]) -> Result<()> {
         self.writer
             .write_all(bytes)
             .map_err(|e| Error::io(&self.partial_path, e))
     }
 
     /// Flushes, closes and renames the partial file to its final name.
-    pub(crate) fn commit(self) -> Result<PathBuf> {
+    pub fn commit(self) -> Result<PathBuf> {
         let Self {
             final_path,
             partial_path,
             writer,
-            in_place,
         } = self;
         // Flushed but not fsync'ed: the rename guards against interrupted runs, and an fsync
         // per synthetic frame would dominate the cost of writing long sequences.
@@ -75,22 +62,21 @@ impl PartialFile {
             .into_inner()
             .map_err(|e| Error::io(&partial_path, e.into_error()))?;
         drop(file);
-        if !in_place {
+        if partial_path != final_path {
             std::fs::rename(&partial_path, &final_path).map_err(|e| Error::io(&final_path, e))?;
         }
         Ok(final_path)
     }
 
     /// Gives up: removes the partial file (used when a one-shot write fails half way).
-    pub(crate) fn abandon(self) {
+    pub fn abandon(self) {
         let Self {
+            final_path,
             partial_path,
             writer,
-            in_place,
-            ..
         } = self;
         drop(writer);
-        if !in_place {
+        if partial_path != final_path {
             // Best effort: the original error is what the caller reports.
             let _ = std::fs::remove_file(partial_path);
         }
@@ -112,8 +98,19 @@ impl Write for PartialFile {
 /// pipe, a terminal): such an output is written in place, since renaming a temporary file
 /// over it would replace the device or pipe with a regular file (for root, `/dev/null`
 /// itself).
-pub fn writes_in_place(path: &Path) -> bool {
+pub(crate) fn writes_in_place(path: &Path) -> bool {
     std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
+/// Where an output for `path` is written before it is committed: `path` itself when it
+/// [`writes_in_place`], `.NAME.partial` beside it otherwise (nothing to rename then when
+/// the two are equal).
+pub(crate) fn write_target(path: &Path) -> Result<PathBuf> {
+    if writes_in_place(path) {
+        Ok(path.to_path_buf())
+    } else {
+        partial_path(path)
+    }
 }
 
 /// `.NAME.partial` in the folder of `path`.

@@ -11,7 +11,7 @@ use sillage_core::{Error, Result, RgbImage};
 
 use super::video::missing_program;
 use crate::WrittenSummary;
-use crate::partial::{partial_path, writes_in_place};
+use crate::partial::write_target;
 
 /// A running `ffmpeg` encoding the frames it is given into an MP4.
 #[derive(Debug)]
@@ -56,12 +56,7 @@ impl Mp4Writer {
         } else {
             "mpeg4"
         };
-        // A device or pipe (`/dev/null`) is written in place: a rename would replace it.
-        let partial_path = if writes_in_place(path) {
-            path.to_path_buf()
-        } else {
-            partial_path(path)?
-        };
+        let partial_path = write_target(path)?;
         let mut child = Command::new(ffmpeg)
             .args([
                 "-y", "-v", "error", "-nostdin", "-f", "rawvideo", "-pix_fmt", "rgb24",
