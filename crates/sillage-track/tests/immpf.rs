@@ -282,25 +282,73 @@ fn blob_proposals_keep_boxes_on_walkers_that_turn_back() {
         blobs_every_frame: true,
     };
     // The box lags behind a walker that turns until the velocity particles catch up; blob
-    // proposals put hypotheses where the walker is at once.
-    let with = PedestrianParams::default();
-    let mut without = with.clone();
-    without.proposal.share = 0.0;
-    let (mut sum_with, mut sum_without) = (0.0, 0.0);
-    for seed in 1..=6 {
-        let e_with = mean_foot_error(&run(&with, scene, seed), 15, 15);
-        let e_without = mean_foot_error(&run(&without, scene, seed), 15, 15);
+    // proposals put hypotheses where the walker is at once. With the paper's fixed colour
+    // reference no seed is worse with them; with the adapted reference (the default) they
+    // still help on average, but the reference learnt from a lagging box makes single seeds
+    // noisier (seed 6: 1.9 px with, 1.4 px without).
+    let fixed_reference = {
+        let mut p = PedestrianParams::default();
+        p.appearance.adapt_rate = 0.0;
+        p
+    };
+    for (with, every_seed) in [
+        (fixed_reference, true),
+        (PedestrianParams::default(), false),
+    ] {
+        let mut without = with.clone();
+        without.proposal.share = 0.0;
+        let (mut sum_with, mut sum_without) = (0.0, 0.0);
+        for seed in 1..=6 {
+            let e_with = mean_foot_error(&run(&with, scene, seed), 15, 15);
+            let e_without = mean_foot_error(&run(&without, scene, seed), 15, 15);
+            assert!(
+                !every_seed || e_with <= 1.1 * e_without,
+                "seed {seed}: {e_with:.2} px with proposals, {e_without:.2} px without"
+            );
+            sum_with += e_with;
+            sum_without += e_without;
+        }
         assert!(
-            e_with <= 1.1 * e_without,
-            "seed {seed}: {e_with:.2} px with proposals, {e_without:.2} px without"
+            sum_with < 0.7 * sum_without,
+            "adapt_rate {}: mean foot error after the turn: {:.2} px with proposals, {:.2} px \
+             without",
+            with.appearance.adapt_rate,
+            sum_with / 6.0,
+            sum_without / 6.0
         );
-        sum_with += e_with;
-        sum_without += e_without;
     }
-    assert!(
-        sum_with < 0.7 * sum_without,
-        "mean foot error after the turn: {:.2} px with proposals, {:.2} px without",
-        sum_with / 6.0,
-        sum_without / 6.0
-    );
+}
+
+/// Two people crossing on one row, seen as detections only: where their boxes meet, the
+/// younger tracker dies as a duplicate of the older, the person it lost is born again after
+/// the crossing and takes the departed identity back: the scene keeps two identities.
+#[test]
+fn a_tracker_lost_as_a_duplicate_at_a_crossing_gives_its_identity_back() {
+    let params = PedestrianParams::default();
+    for seed in 1..=3 {
+        let mut tracker =
+            PedestrianTracker::new(&params, BoxSizing::FromCandidate, None, (W, H), seed).unwrap();
+        let mut out = Vec::new();
+        for frame in 0..60u64 {
+            let f = frame as f64;
+            let candidates = [60.0 + 3.0 * f, 240.0 - 3.0 * f].map(|x| Candidate {
+                bbox: PersonBox::standing_on(sillage_core::Point2::new(x, 150.0), 16.0, 48.0),
+                score: 1.0,
+            });
+            let observations = PedestrianFrame {
+                frame,
+                cues: None,
+                candidates: &candidates,
+            };
+            tracker.step(&observations, &mut out).unwrap();
+        }
+        let mut ids: Vec<u64> = out.iter().map(|e| e.track_id).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        assert_eq!(ids.len(), 2, "seed {seed}: identities {ids:?}");
+        assert!(
+            out.iter().any(|e| e.frame == 59),
+            "seed {seed}: tracked to the end"
+        );
+    }
 }

@@ -4,7 +4,8 @@
 //! when the tracker was created by the Bhattacharyya distance:
 //! `ln p(Z | X) = −λ_c (d²_top + d²_bottom) − λ_m d²_motion − λ_f (1 − f)`,
 //! `d² = 1 − Σᵢ √(hᵢ h_ref,ᵢ)`, where the last term, ours, weighs the share `f` of the box the
-//! background subtraction marks as foreground (0 in the paper's model, `λ_f = 0`).
+//! background subtraction marks as foreground (0 in the paper's model, `λ_f = 0`). The
+//! references follow the person slowly ([`Appearance::adapt`], also ours).
 
 use serde::{Deserialize, Serialize};
 use sillage_core::{Error, GrayImage, Image, Result, RgbImage};
@@ -38,6 +39,17 @@ pub struct AppearanceParams {
     /// Every `stride`-th row and column of a box is counted; default 2 (a quarter of the
     /// pixels: the histograms of 30×70 px boxes change little, the cost falls 4×).
     pub stride: usize,
+    /// α of the reference update `h_ref ← (1 − α) h_ref + α h(estimate)` (Nummiaro,
+    /// Koller-Meier & Van Gool, "An adaptive color-based particle filter", 2003; not in the
+    /// IMM-PF paper), made after each frame whose estimated box scores at least
+    /// `adapt_min_log_likelihood`; default 0.05. 0 keeps the reference taken at birth (the
+    /// paper). On PETS 2009 S2.L1 the colour distance of a followed person to its birth
+    /// reference grows over 100 frames until the tracker dies (docs/immpf.md).
+    pub adapt_rate: f64,
+    /// The colour log-likelihood `−λ_c (d²_top + d²_bottom)` the estimated box must reach
+    /// for the reference to be updated; default −3 (`d²_top + d²_bottom ≤ 0.15` with
+    /// λ_c = 20), so that a box sliding off its person does not teach the reference.
+    pub adapt_min_log_likelihood: f64,
 }
 
 impl Default for AppearanceParams {
@@ -50,6 +62,8 @@ impl Default for AppearanceParams {
             motion_bins: 8,
             motion_full_scale: 0.25,
             stride: 2,
+            adapt_rate: 0.05,
+            adapt_min_log_likelihood: -3.0,
         }
     }
 }
@@ -70,6 +84,20 @@ impl AppearanceParams {
                     "must be a finite weight ≥ 0 (Pérez et al. use 20)",
                 ));
             }
+        }
+        if !(0.0..=1.0).contains(&self.adapt_rate) {
+            return Err(Error::parameter(
+                "adapt_rate",
+                self.adapt_rate,
+                "must be in [0, 1] (0 keeps the reference of the birth)",
+            ));
+        }
+        if !(self.adapt_min_log_likelihood.is_finite() && self.adapt_min_log_likelihood <= 0.0) {
+            return Err(Error::parameter(
+                "adapt_min_log_likelihood",
+                self.adapt_min_log_likelihood,
+                "must be a finite log-likelihood ≤ 0",
+            ));
         }
         if !(2..=256).contains(&self.motion_bins) {
             return Err(Error::parameter(
@@ -188,12 +216,72 @@ impl Appearance {
         })
     }
 
-    /// `ln p(Z | X)` of a person in `person` (§4.3).
     /// The share of the box's pixels whose frame difference leaves the first motion bin (is
     /// at least `motion_full_scale / motion_bins`): how much of the box moves; `None` without
     /// a previous frame.
     pub fn moving_share(&self) -> Option<f64> {
         self.motion.as_ref().map(|h| 1.0 - f64::from(h[0]))
+    }
+
+    /// `−λ_c (d²_top + d²_bottom)` of `person`, the colour part of the likelihood; `None`
+    /// when a half of the box holds no pixel.
+    fn colour_log_likelihood(
+        &self,
+        params: &AppearanceParams,
+        cues: &FrameCues,
+        person: &PersonBox,
+        scratch: &mut HistogramScratch,
+    ) -> Option<f64> {
+        let h = &mut scratch.colour;
+        match (
+            squared_distance(&cues.colour, person.half(true), &self.top, params.stride, h),
+            squared_distance(
+                &cues.colour,
+                person.half(false),
+                &self.bottom,
+                params.stride,
+                h,
+            ),
+        ) {
+            (Some(top), Some(bottom)) => Some(-params.colour_weight * (top + bottom)),
+            _ => None,
+        }
+    }
+
+    /// Blends the histograms of `person` (the tracker's estimate) into the reference, at
+    /// `adapt_rate`, when its colour likelihood reaches `adapt_min_log_likelihood`: the
+    /// reference follows slow changes of light and pose (Nummiaro et al. 2003) while a box
+    /// that has slid off its person leaves it as it is. Returns whether it was updated.
+    pub fn adapt(
+        &mut self,
+        params: &AppearanceParams,
+        cues: &FrameCues,
+        person: &PersonBox,
+        scratch: &mut HistogramScratch,
+    ) -> bool {
+        let rate = params.adapt_rate as f32;
+        if rate <= 0.0
+            || !self
+                .colour_log_likelihood(params, cues, person, scratch)
+                .is_some_and(|log| log >= params.adapt_min_log_likelihood)
+        {
+            return false;
+        }
+        let mut blend = |bins: &BinImage, b: PersonBox, reference: &mut [f32]| {
+            let h = &mut scratch.colour;
+            h.resize(bins.bins(), 0.0);
+            if box_histogram(bins, &b, params.stride, h) > 0 {
+                for (r, &v) in reference.iter_mut().zip(h.iter()) {
+                    *r = (1.0 - rate) * *r + rate * v;
+                }
+            }
+        };
+        blend(&cues.colour, person.half(true), &mut self.top);
+        blend(&cues.colour, person.half(false), &mut self.bottom);
+        if let (Some(motion), true) = (&mut self.motion, cues.has_motion) {
+            blend(&cues.motion, *person, motion);
+        }
+        true
     }
 
     /// `ln p(Z | X)` of a person in `person` (§4.3).
@@ -204,34 +292,14 @@ impl Appearance {
         person: &PersonBox,
         scratch: &mut HistogramScratch,
     ) -> f64 {
-        let distance = |bins: &BinImage, b: PersonBox, reference: &[f32], h: &mut Vec<f32>| {
-            h.resize(bins.bins(), 0.0);
-            if box_histogram(bins, &b, params.stride, h) == 0 {
-                return None;
-            }
-            Some((1.0 - bhattacharyya_coefficient(h, reference)).max(0.0))
-        };
-        let (Some(top), Some(bottom)) = (
-            distance(
-                &cues.colour,
-                person.half(true),
-                &self.top,
-                &mut scratch.colour,
-            ),
-            distance(
-                &cues.colour,
-                person.half(false),
-                &self.bottom,
-                &mut scratch.colour,
-            ),
-        ) else {
+        let Some(mut log) = self.colour_log_likelihood(params, cues, person, scratch) else {
             return OUTSIDE_LOG_LIKELIHOOD;
         };
-        let mut log = -params.colour_weight * (top + bottom);
         if let (Some(reference), true) =
             (&self.motion, cues.has_motion && params.motion_weight > 0.0)
         {
-            match distance(&cues.motion, *person, reference, &mut scratch.motion) {
+            let h = &mut scratch.motion;
+            match squared_distance(&cues.motion, *person, reference, params.stride, h) {
                 Some(d) => log -= params.motion_weight * d,
                 None => return OUTSIDE_LOG_LIKELIHOOD,
             }
@@ -242,6 +310,20 @@ impl Appearance {
         }
         log
     }
+}
+
+/// `d² = 1 − Σᵢ √(hᵢ h_ref,ᵢ)` between the histogram of `b` (computed into `h`) and
+/// `reference`; `None` when `b` holds no pixel.
+fn squared_distance(
+    bins: &BinImage,
+    b: PersonBox,
+    reference: &[f32],
+    stride: usize,
+    h: &mut Vec<f32>,
+) -> Option<f64> {
+    h.resize(bins.bins(), 0.0);
+    (box_histogram(bins, &b, stride, h) > 0)
+        .then(|| (1.0 - bhattacharyya_coefficient(h, reference)).max(0.0))
 }
 
 /// The normalised histogram of the bins inside `b` (clipped to the image) into `out`; the
@@ -255,4 +337,72 @@ fn box_histogram(bins: &BinImage, b: &PersonBox, stride: usize, out: &mut [f32])
     };
     // `out` has one entry per bin and the stride is validated: no error is possible.
     bins.box_histogram(&region, stride, out).unwrap_or(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sillage_core::Point2;
+
+    /// Cues of a 40×60 grey frame with a 16×40 person (rows 10-49) whose rows are of
+    /// `colour(row)`.
+    fn cues_with(params: &AppearanceParams, colour: impl Fn(usize) -> [u8; 3]) -> FrameCues {
+        let (w, h) = (40, 60);
+        let mut rgb = RgbImage::from_vec(w, h, vec![[120, 120, 120]; w * h]).unwrap();
+        for y in 10..50 {
+            for x in 12..28 {
+                rgb.set(x, y, colour(y));
+            }
+        }
+        let grey = GrayImage::from_vec(w, h, vec![0.5; w * h]).unwrap();
+        let mut cues = FrameCues::default();
+        cues.update(params, &rgb, &grey, None, None).unwrap();
+        cues
+    }
+
+    #[test]
+    fn the_reference_follows_a_slow_change_and_ignores_a_poor_match() {
+        let params = AppearanceParams {
+            adapt_rate: 0.5,
+            adapt_min_log_likelihood: -15.0,
+            ..AppearanceParams::default()
+        };
+        let person = PersonBox::standing_on(Point2::new(20.0, 50.0), 16.0, 40.0);
+        let (red, blue) = ([200, 30, 30], [30, 30, 160]);
+        let born = cues_with(&params, |y| if y < 30 { red } else { blue });
+        let mut appearance = Appearance::capture(&params, &born, &person).unwrap();
+        let mut scratch = HistogramScratch::default();
+        // A third of the shirt turns yellow (a scarf, a turn): the colour likelihood drops,
+        // then recovers as the reference learns it.
+        let later = cues_with(&params, |y| match y {
+            ..17 => [220, 200, 40],
+            17..30 => red,
+            _ => blue,
+        });
+        let colour = |appearance: &Appearance, scratch: &mut HistogramScratch| {
+            appearance
+                .colour_log_likelihood(&params, &later, &person, scratch)
+                .unwrap()
+        };
+        let before = colour(&appearance, &mut scratch);
+        assert!(before < -0.5, "a change to learn: {before}");
+        assert!(appearance.adapt(&params, &later, &person, &mut scratch));
+        let after = colour(&appearance, &mut scratch);
+        assert!(after > before + 0.2, "{before} → {after}");
+        // A box on someone else (other colours) is below the gate: nothing is learnt.
+        let stranger = cues_with(
+            &params,
+            |y| if y < 30 { [30, 160, 40] } else { [90, 60, 20] },
+        );
+        let kept = appearance.clone();
+        assert!(!appearance.adapt(&params, &stranger, &person, &mut scratch));
+        assert_eq!(appearance, kept);
+        // α = 0 is the paper's fixed reference.
+        let fixed = AppearanceParams {
+            adapt_rate: 0.0,
+            ..params
+        };
+        assert!(!appearance.adapt(&fixed, &later, &person, &mut scratch));
+        assert_eq!(appearance, kept);
+    }
 }

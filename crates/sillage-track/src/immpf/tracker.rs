@@ -103,6 +103,19 @@ struct Departed {
     frame: FrameIndex,
 }
 
+impl Departed {
+    /// `track`, removed at `frame`: its identity, last foot point and velocity.
+    fn of(track: &Track, frame: FrameIndex) -> Self {
+        let mean = track.filter.estimate().mean;
+        Self {
+            track_id: track.filter.track_id(),
+            foot: track.bbox.foot(),
+            vel_px_per_frame: Vec2::new(mean.at(2), mean.at(3)),
+            frame,
+        }
+    }
+}
+
 impl PedestrianTracker {
     /// A tracker for frames of `frame_size_px` (width, height); `prior` is the learned
     /// motion prior, required when the models include MP. Parameters are validated here.
@@ -234,6 +247,9 @@ impl PedestrianTracker {
                 }
                 let foot = estimate_foot(&track.filter);
                 track.bbox = sizing.box_at(foot, track.size_px);
+                if let (Some(cues), Some(appearance)) = (cues, &mut track.appearance) {
+                    appearance.adapt(&params.appearance, cues, &track.bbox, scratch);
+                }
             });
     }
 
@@ -348,13 +364,7 @@ impl PedestrianTracker {
                 && foot.y < height + t.bbox.height_px / 2.0;
             let alive = t.low_frames < death_frames && t.unsupported_frames < unsupported;
             if inside && !alive && t.age >= confirm && revive > 0 {
-                let mean = t.filter.estimate().mean;
-                departed.push(Departed {
-                    track_id: t.filter.track_id(),
-                    foot,
-                    vel_px_per_frame: Vec2::new(mean.at(2), mean.at(3)),
-                    frame,
-                });
+                departed.push(Departed::of(t, frame));
             }
             inside && alive
         });
@@ -371,8 +381,18 @@ impl PedestrianTracker {
                 }
             }
         }
+        // A confirmed duplicate departs too: where two trackers met on one person (people
+        // crossing, a group), the person the younger one lost is usually next to it and is
+        // born again within a few frames; it then takes the identity back.
         let mut flags = keep.into_iter();
-        self.tracks.retain(|_| flags.next().unwrap_or(true));
+        let departed = &mut self.departed;
+        self.tracks.retain(|t| {
+            let keep = flags.next().unwrap_or(true);
+            if !keep && t.age >= confirm && revive > 0 {
+                departed.push(Departed::of(t, frame));
+            }
+            keep
+        });
     }
 
     /// Starts a tracker on every candidate that no live tracker explains.
