@@ -200,6 +200,9 @@ fn motion_state_scores_per_state() {
 /// 0.3; (2,10) 0.2 / 2 = 0.1. Best mapping {1–10, 2–20}: STDA = 1.7/3 + 0.3 = 0.8667 (the
 /// other, {1–20, 2–10}, gives 0.1333). ATA = STDA / ((2 + 3)/2); MOTP = (1.7 + 0.6) /
 /// (2 + 1) frames where both of a mapped pair exist.
+///
+/// TrackEval's relaxed ATA counts the frames of a pair with overlap ≥ 0.5: (1,10) 2 of 3,
+/// (2,20) 1 of 2, the others none; STDA 2/3 + 1/2 over (2 + 3)/2.
 #[test]
 fn vace_by_hand() {
     let frame = |frame, truth: &[u64], estimates: &[u64], similarity: &[f64]| FrameSimilarities {
@@ -223,6 +226,8 @@ fn vace_by_hand() {
     close("STDA", v.stda, stda);
     close("ATA", v.ata, stda / 2.5);
     close("MOTP", v.motp, 2.3 / 3.0);
+    close("relaxed STDA", v.stda_relaxed, 2.0 / 3.0 + 0.5);
+    close("relaxed ATA", v.ata_relaxed, (2.0 / 3.0 + 0.5) / 2.5);
     assert_eq!(
         (v.truth_tracks, v.estimate_tracks, v.track_mapped_frames),
         (2, 3, 3)
@@ -438,6 +443,7 @@ proptest! {
         prop_assert_eq!((p.bedload.false_negative_rate, p.bedload.false_positive_rate), (0.0, 0.0));
         let v = p.vace;
         prop_assert_eq!((v.sfda, v.ata, v.n_modp, v.motp), (1.0, 1.0, 1.0, 1.0));
+        prop_assert_eq!(v.ata_relaxed, 1.0);
         let e = p.etiseo;
         prop_assert_eq!((e.tracking_time, e.id_persistence, e.id_confusion, e.mean), (1.0, 1.0, 1.0, 1.0));
         let m = p.motion_states.unwrap();

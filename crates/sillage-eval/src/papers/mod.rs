@@ -5,7 +5,8 @@
 //! - the MMPF+ paper (Lafaye de Micheaux et al. 2018, §5.3): percentage of correct tracks,
 //!   FN and FP rates ([`bedload_scores`]), and per-state precision, recall and F-score of
 //!   the motion states resting, rolling, saltating ([`motion_state_scores`]);
-//! - the IMM-PF paper (Madrigal & Hayet, §5.2): VACE's SFDA, ATA, N-MODP, MOTP ([`vace()`]);
+//! - the IMM-PF paper (Madrigal & Hayet, §5.2): VACE's SFDA, ATA, N-MODP, MOTP ([`vace()`]),
+//!   and TrackEval's relaxed ATA beside Kasturi et al.'s;
 //! - the SIFT-PF paper (Souded et al. 2011, §3): ETISEO's M1 tracking time, M2 object ID
 //!   persistence, M3 object ID confusion and their mean ([`etiseo()`]).
 //!
@@ -57,4 +58,4 @@ pub use bedload::{
 };
 pub use etiseo::{EtiseoMetrics, etiseo};
 pub use report::{PaperMetrics, PapersReport};
-pub use vace::{VaceMetrics, vace};
+pub use vace::{RELAXED_OVERLAP, VaceMetrics, vace};

@@ -46,6 +46,12 @@ pub struct VaceMetrics {
     pub sfda: f64,
     /// Average Tracking Accuracy: `STDA / ((N_G + N_D) / 2)`.
     pub ata: f64,
+    /// TrackEval's relaxed STDA: as `stda`, with each frame of a pair counting 1 when their
+    /// overlap reaches [`RELAXED_OVERLAP`] and 0 otherwise.
+    pub stda_relaxed: f64,
+    /// TrackEval's relaxed ATA: `stda_relaxed / ((N_G + N_D) / 2)` (TrackEval's `VACE`
+    /// reports it as `ATA`).
+    pub ata_relaxed: f64,
     /// Normalised Multiple Object Detection Precision: mean `MODP(t)` over the frames with
     /// a mapped pair.
     pub n_modp: f64,
@@ -53,6 +59,10 @@ pub struct VaceMetrics {
     /// pairs over the frames where both exist (not CLEAR MOT's MOTP).
     pub motp: f64,
 }
+
+/// The overlap from which a frame counts 1 in TrackEval's relaxed ATA (its `VACE`
+/// threshold).
+pub const RELAXED_OVERLAP: f64 = 0.5;
 
 /// Scores `data` with the VACE metrics of the IMM-PF paper (§5.2), all in `[0, 1]`, 1 best.
 /// The overlap of a true and an estimated object is their similarity in `data` (IoU with
@@ -75,9 +85,12 @@ pub struct VaceMetrics {
 /// - `MOTP = Σ_mapped Σ_t overlap / Σ_t N_mapped(t)`, `N_mapped(t)` the mapped trajectory
 ///   pairs that both exist in frame `t`.
 ///
-/// TrackEval's `VACE` gives the same SFDA but a "relaxed" ATA that counts a frame as 1 when
-/// the overlap reaches 0.5 and 0 otherwise; this follows Kasturi et al. A score whose
-/// denominator is 0 (an empty sequence) is 0.
+/// `ata` follows Kasturi et al.; TrackEval's `VACE` gives the same SFDA but a "relaxed" ATA
+/// that counts a frame of a pair as 1 when their overlap reaches 0.5 and 0 otherwise (every
+/// pair of the frame, not only the mapped ones), trajectories then mapped one to one
+/// maximising `Σ_t [overlap ≥ 0.5] / |frames where either exists|`: `ata_relaxed`, so that
+/// figures computed by either convention can be compared. A score whose denominator is 0
+/// (an empty sequence) is 0.
 pub fn vace(data: &MotData) -> VaceMetrics {
     let mut matcher = Matcher::default();
     let mut edges: Vec<Edge> = Vec::new();
@@ -86,6 +99,7 @@ pub fn vace(data: &MotData) -> VaceMetrics {
     let mut truth_frames: Vec<Vec<u32>> = vec![Vec::new(); data.truth_id_count()];
     let mut estimate_frames: Vec<Vec<u32>> = vec![Vec::new(); data.estimate_id_count()];
     let mut overlap: IdMap<u64, f64> = IdMap::default();
+    let mut relaxed_frames: IdMap<u64, u64> = IdMap::default();
     let mut sums = VaceSums::default();
     for (k, frame) in data.frames().enumerate() {
         let (n, m) = (frame.truth_ids.len(), frame.estimate_ids.len());
@@ -107,6 +121,9 @@ pub fn vace(data: &MotData) -> VaceMetrics {
                 frame.estimate_ids[p.estimate as usize],
             );
             *overlap.entry(key).or_insert(0.0) += p.similarity;
+            if p.similarity >= RELAXED_OVERLAP {
+                *relaxed_frames.entry(key).or_insert(0) += 1;
+            }
         }
         matcher.solve(n, m, &edges, Objective::MaxWeight, &mut matched);
         let mapped: f64 = matched.iter().map(|&i| edges[i].value).sum();
@@ -121,18 +138,26 @@ pub fn vace(data: &MotData) -> VaceMetrics {
     let mut pairs: Vec<(u64, f64)> = overlap.into_iter().collect();
     pairs.sort_unstable_by_key(|&(key, _)| key);
     let mut both_present = Vec::with_capacity(pairs.len());
+    let mut relaxed_edges = Vec::new();
     edges.clear();
     for &(key, overlap_sum) in &pairs {
         let (g, e) = split_pair_key(key);
         let (g_frames, e_frames) = (&truth_frames[g as usize], &estimate_frames[e as usize]);
         let both = common_count(g_frames, e_frames);
         both_present.push(both);
-        let either = g_frames.len() as u64 + e_frames.len() as u64 - both;
+        let either = (g_frames.len() as u64 + e_frames.len() as u64 - both) as f64;
         edges.push(Edge {
             row: g,
             col: e,
-            value: overlap_sum / either as f64,
+            value: overlap_sum / either,
         });
+        if let Some(&frames) = relaxed_frames.get(&key) {
+            relaxed_edges.push(Edge {
+                row: g,
+                col: e,
+                value: frames as f64 / either,
+            });
+        }
     }
     matcher.solve(
         data.truth_id_count(),
@@ -146,6 +171,14 @@ pub fn vace(data: &MotData) -> VaceMetrics {
         sums.track_overlap_sum += pairs[k].1;
         sums.track_mapped_frames += both_present[k];
     }
+    matcher.solve(
+        data.truth_id_count(),
+        data.estimate_id_count(),
+        &relaxed_edges,
+        Objective::MaxWeight,
+        &mut matched,
+    );
+    sums.stda_relaxed = matched.iter().map(|&k| relaxed_edges[k].value).sum();
     sums.truth_tracks = data.truth_id_count() as u64;
     sums.estimate_tracks = data.estimate_id_count() as u64;
     VaceMetrics::from_sums(sums)
@@ -178,6 +211,7 @@ struct VaceSums {
     truth_tracks: u64,
     estimate_tracks: u64,
     stda: f64,
+    stda_relaxed: f64,
     track_overlap_sum: f64,
     track_mapped_frames: u64,
 }
@@ -185,6 +219,7 @@ struct VaceSums {
 impl VaceMetrics {
     fn from_sums(s: VaceSums) -> Self {
         let ratio = |num: f64, den: f64| if den > 0.0 { num / den } else { 0.0 };
+        let mean_tracks = 0.5 * (s.truth_tracks as f64 + s.estimate_tracks as f64);
         Self {
             frames: s.frames,
             fda_sum: s.fda_sum,
@@ -196,10 +231,9 @@ impl VaceMetrics {
             track_overlap_sum: s.track_overlap_sum,
             track_mapped_frames: s.track_mapped_frames,
             sfda: ratio(s.fda_sum, s.frames as f64),
-            ata: ratio(
-                s.stda,
-                0.5 * (s.truth_tracks as f64 + s.estimate_tracks as f64),
-            ),
+            ata: ratio(s.stda, mean_tracks),
+            stda_relaxed: s.stda_relaxed,
+            ata_relaxed: ratio(s.stda_relaxed, mean_tracks),
             n_modp: ratio(s.modp_sum, s.mapped_frames as f64),
             motp: ratio(s.track_overlap_sum, s.track_mapped_frames as f64),
         }
@@ -217,6 +251,7 @@ impl VaceMetrics {
             s.truth_tracks += m.truth_tracks;
             s.estimate_tracks += m.estimate_tracks;
             s.stda += m.stda;
+            s.stda_relaxed += m.stda_relaxed;
             s.track_overlap_sum += m.track_overlap_sum;
             s.track_mapped_frames += m.track_mapped_frames;
         }
@@ -225,7 +260,9 @@ impl VaceMetrics {
 
     /// The heading of its tables.
     pub(crate) fn title(&self) -> String {
-        "VACE, IMM-PF paper §5.2 (overlap = similarity, no threshold; scores in %)".to_owned()
+        "VACE, IMM-PF paper §5.2 (overlap = similarity, no threshold; ATA(0.5): TrackEval's \
+         relaxed ATA; scores in %)"
+            .to_owned()
     }
 
     /// The table columns: name and formatted value.
@@ -233,6 +270,7 @@ impl VaceMetrics {
         vec![
             ("SFDA", score(self.sfda)),
             ("ATA", score(self.ata)),
+            ("ATA(0.5)", score(self.ata_relaxed)),
             ("N-MODP", score(self.n_modp)),
             ("MOTP", score(self.motp)),
             ("Frames", count(self.frames)),
