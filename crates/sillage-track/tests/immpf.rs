@@ -247,6 +247,15 @@ fn frames_out_of_order_and_bad_parameters_are_refused() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("proposal.share"), "{err}");
+    for (rate, gate) in [(1.5, -3.0), (-0.1, -3.0), (0.05, f64::NAN), (0.05, 2.0)] {
+        let mut bad = PedestrianParams::default();
+        bad.appearance.adapt_rate = rate;
+        bad.appearance.adapt_min_log_likelihood = gate;
+        let err = PedestrianTracker::new(&bad, BoxSizing::FromCandidate, None, (W, H), 1)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("appearance.adapt_"), "{rate}, {gate}: {err}");
+    }
     let mp = PedestrianParams {
         models: vec![ModelName::Mp],
         ..Default::default()

@@ -73,9 +73,9 @@ impl AppearanceParams {
     pub fn validate(&self) -> Result<()> {
         self.binning.validate()?;
         for (key, value) in [
-            ("colour_weight", self.colour_weight),
-            ("motion_weight", self.motion_weight),
-            ("foreground_weight", self.foreground_weight),
+            ("appearance.colour_weight", self.colour_weight),
+            ("appearance.motion_weight", self.motion_weight),
+            ("appearance.foreground_weight", self.foreground_weight),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(Error::parameter(
@@ -87,35 +87,35 @@ impl AppearanceParams {
         }
         if !(0.0..=1.0).contains(&self.adapt_rate) {
             return Err(Error::parameter(
-                "adapt_rate",
+                "appearance.adapt_rate",
                 self.adapt_rate,
                 "must be in [0, 1] (0 keeps the reference of the birth)",
             ));
         }
         if !(self.adapt_min_log_likelihood.is_finite() && self.adapt_min_log_likelihood <= 0.0) {
             return Err(Error::parameter(
-                "adapt_min_log_likelihood",
+                "appearance.adapt_min_log_likelihood",
                 self.adapt_min_log_likelihood,
                 "must be a finite log-likelihood ≤ 0",
             ));
         }
         if !(2..=256).contains(&self.motion_bins) {
             return Err(Error::parameter(
-                "motion_bins",
+                "appearance.motion_bins",
                 self.motion_bins,
                 "must be in 2..=256",
             ));
         }
         if !(self.motion_full_scale > 0.0 && self.motion_full_scale <= 1.0) {
             return Err(Error::parameter(
-                "motion_full_scale",
+                "appearance.motion_full_scale",
                 self.motion_full_scale,
                 "must be a grey-level difference in (0, 1]",
             ));
         }
         if !(1..=16).contains(&self.stride) {
             return Err(Error::parameter(
-                "stride",
+                "appearance.stride",
                 self.stride,
                 "must be in 1..=16 pixels",
             ));
