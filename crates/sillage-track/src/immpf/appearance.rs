@@ -224,7 +224,8 @@ impl Appearance {
     }
 
     /// `−λ_c (d²_top + d²_bottom)` of `person`, the colour part of the likelihood; `None`
-    /// when a half of the box holds no pixel.
+    /// when a half of the box holds no pixel. The histograms of the top and bottom halves
+    /// are left in `scratch.colour` and `scratch.motion`.
     fn colour_log_likelihood(
         &self,
         params: &AppearanceParams,
@@ -232,20 +233,17 @@ impl Appearance {
         person: &PersonBox,
         scratch: &mut HistogramScratch,
     ) -> Option<f64> {
-        let h = &mut scratch.colour;
-        match (
-            squared_distance(&cues.colour, person.half(true), &self.top, params.stride, h),
-            squared_distance(
-                &cues.colour,
-                person.half(false),
-                &self.bottom,
-                params.stride,
-                h,
-            ),
-        ) {
-            (Some(top), Some(bottom)) => Some(-params.colour_weight * (top + bottom)),
-            _ => None,
-        }
+        let (top, bottom) = (&mut scratch.colour, &mut scratch.motion);
+        let stride = params.stride;
+        let d_top = squared_distance(&cues.colour, person.half(true), &self.top, stride, top)?;
+        let d_bottom = squared_distance(
+            &cues.colour,
+            person.half(false),
+            &self.bottom,
+            stride,
+            bottom,
+        )?;
+        Some(-params.colour_weight * (d_top + d_bottom))
     }
 
     /// Blends the histograms of `person` (the tracker's estimate) into the reference, at
@@ -267,19 +265,20 @@ impl Appearance {
         {
             return false;
         }
-        let mut blend = |bins: &BinImage, b: PersonBox, reference: &mut [f32]| {
-            let h = &mut scratch.colour;
-            h.resize(bins.bins(), 0.0);
-            if box_histogram(bins, &b, params.stride, h) > 0 {
-                for (r, &v) in reference.iter_mut().zip(h.iter()) {
-                    *r = (1.0 - rate) * *r + rate * v;
-                }
+        let blend = |reference: &mut [f32], h: &[f32]| {
+            for (r, &v) in reference.iter_mut().zip(h) {
+                *r = (1.0 - rate) * *r + rate * v;
             }
         };
-        blend(&cues.colour, person.half(true), &mut self.top);
-        blend(&cues.colour, person.half(false), &mut self.bottom);
+        // The halves' histograms were just computed for the gate.
+        blend(&mut self.top, &scratch.colour);
+        blend(&mut self.bottom, &scratch.motion);
         if let (Some(motion), true) = (&mut self.motion, cues.has_motion) {
-            blend(&cues.motion, *person, motion);
+            let h = &mut scratch.motion;
+            h.resize(cues.motion.bins(), 0.0);
+            if box_histogram(&cues.motion, person, params.stride, h) > 0 {
+                blend(motion, h);
+            }
         }
         true
     }
