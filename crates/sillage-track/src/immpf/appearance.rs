@@ -187,8 +187,10 @@ pub struct Appearance {
 /// Scratch histograms, one set per thread.
 #[derive(Debug, Clone, Default)]
 pub struct HistogramScratch {
-    colour: Vec<f32>,
-    motion: Vec<f32>,
+    /// The top half's colour histogram.
+    top: Vec<f32>,
+    /// The bottom half's colour histogram, then the motion histogram.
+    bottom_or_motion: Vec<f32>,
 }
 
 /// `ln p(Z | X)` below which a box is worthless: a box entirely outside the image.
@@ -225,7 +227,7 @@ impl Appearance {
 
     /// `−λ_c (d²_top + d²_bottom)` of `person`, the colour part of the likelihood; `None`
     /// when a half of the box holds no pixel. The histograms of the top and bottom halves
-    /// are left in `scratch.colour` and `scratch.motion`.
+    /// are left in `scratch`.
     fn colour_log_likelihood(
         &self,
         params: &AppearanceParams,
@@ -233,7 +235,7 @@ impl Appearance {
         person: &PersonBox,
         scratch: &mut HistogramScratch,
     ) -> Option<f64> {
-        let (top, bottom) = (&mut scratch.colour, &mut scratch.motion);
+        let (top, bottom) = (&mut scratch.top, &mut scratch.bottom_or_motion);
         let stride = params.stride;
         let d_top = squared_distance(&cues.colour, person.half(true), &self.top, stride, top)?;
         let d_bottom = squared_distance(
@@ -271,10 +273,10 @@ impl Appearance {
             }
         };
         // The halves' histograms were just computed for the gate.
-        blend(&mut self.top, &scratch.colour);
-        blend(&mut self.bottom, &scratch.motion);
+        blend(&mut self.top, &scratch.top);
+        blend(&mut self.bottom, &scratch.bottom_or_motion);
         if let (Some(motion), true) = (&mut self.motion, cues.has_motion) {
-            let h = &mut scratch.motion;
+            let h = &mut scratch.bottom_or_motion;
             h.resize(cues.motion.bins(), 0.0);
             if box_histogram(&cues.motion, person, params.stride, h) > 0 {
                 blend(motion, h);
@@ -297,7 +299,7 @@ impl Appearance {
         if let (Some(reference), true) =
             (&self.motion, cues.has_motion && params.motion_weight > 0.0)
         {
-            let h = &mut scratch.motion;
+            let h = &mut scratch.bottom_or_motion;
             match squared_distance(&cues.motion, *person, reference, params.stride, h) {
                 Some(d) => log -= params.motion_weight * d,
                 None => return OUTSIDE_LOG_LIKELIHOOD,
