@@ -30,6 +30,7 @@ const EXAMPLES: &str = "Examples:
   sillage bench ptv --particles 1000,5000,25000
   sillage bench bedload --frames 100 --real shared/data/bedload_beads_lafaye2018 --mask base.png
   sillage fit bedload --truth trackdatatruth.csv --out motion.toml
+  sillage detect motion PETS09-S2L1/img1 --out motion_det.txt
   sillage fit motion-prior PETS09-S2L1/gt/gt.txt --out prior.json
   sillage fit homography PETS09-S2L1/gt/gt.txt --out ground.toml
   sillage detect bead 'flume/*.tif' --sequence-params sequence_param.txt --mask base.png --out det.csv --candidates cand.csv
@@ -1199,6 +1200,33 @@ pub enum DetectCommand {
     /// Bedload beads (MMPF+ paper §3.3): black beads by threshold, transparent beads by ring
     /// correlation, and the detector-confidence candidates of Eq. (1).
     Bead(DetectBeadArgs),
+    /// Moving objects (the pedestrian and surveillance trackers' detector): adaptive
+    /// Gaussian-mixture background, morphology and blobs, written as MOTChallenge detections.
+    Motion(DetectMotionArgs),
+}
+
+/// `sillage detect motion`.
+#[derive(Debug, Args)]
+pub struct DetectMotionArgs {
+    /// Frames: a folder, a quoted glob pattern, a multi-page TIFF or a video file.
+    pub input: String,
+    /// MOTChallenge detections to write (`frame,-1,left,top,width,height,conf,-1,-1,-1`;
+    /// frames 1-based, conf the share of motion pixels in the box).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// TOML motion-detector parameters (the `[motion_detector]` table of the trackers'
+    /// configurations, without its header).
+    #[arg(long, value_name = "FILE")]
+    pub detector_config: Option<PathBuf>,
+    /// Override one detector key, e.g. `--detector-set open_radius_px=2` (repeatable).
+    #[arg(long = "detector-set", value_name = "KEY=VALUE")]
+    pub detector_overrides: Vec<String>,
+    /// Stop after this many frames.
+    #[arg(long, value_name = "N")]
+    pub max_frames: Option<usize>,
+    /// Print a machine-readable summary on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Options of the bead detector shared by `detect bead` and `track bedload FRAMES`.

@@ -15,6 +15,7 @@ mod cli;
 mod demo;
 mod demo_bedload;
 mod detect;
+mod detect_motion;
 mod eulerian;
 mod eulerian_plots;
 mod eval;
@@ -67,6 +68,7 @@ fn main() {
         cli::Command::Track(cli::TrackCommand::Immpf(a)) => track_immpf::run(&a),
         cli::Command::Track(cli::TrackCommand::Siftpf(a)) => track_siftpf::run(&a),
         cli::Command::Detect(cli::DetectCommand::Bead(a)) => detect::run_bead(&a),
+        cli::Command::Detect(cli::DetectCommand::Motion(a)) => detect_motion::run_motion(&a),
         cli::Command::Eulerian(a) => eulerian::run(&a),
         cli::Command::Plot(a) => plot::run(&a),
         cli::Command::Overlay(a) => overlay::run(&a),
