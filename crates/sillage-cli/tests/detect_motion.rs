@@ -2,10 +2,8 @@
 //! MOTChallenge detections that land on the true walkers, and bad options are user errors
 //! naming the key.
 
-use std::path::Path;
-
 mod common;
-use common::{path_str, run_ok, run_user_error};
+use common::{path_str, run_ok, run_user_error, synth_walkers};
 use sillage::io::{MotRow, read_mot_rows};
 
 const FRAMES: u64 = 60;
@@ -18,25 +16,11 @@ fn iou(a: &MotRow, b: &MotRow) -> f64 {
     inter / (a.width_px * a.height_px + b.width_px * b.height_px - inter)
 }
 
-/// Writes `scenario` walkers of `FRAMES` frames into `seq` (img1/, gt/gt.txt, seqinfo.ini).
-fn walkers(seq: &Path, scenario: &str) {
-    run_ok(&[
-        "synth",
-        "walkers",
-        "--scenario",
-        scenario,
-        "--frames",
-        &FRAMES.to_string(),
-        "--out",
-        path_str(seq),
-    ]);
-}
-
 #[test]
 fn motion_blobs_are_written_as_detections_on_the_walkers() {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("crossing");
-    walkers(&seq, "crossing");
+    synth_walkers(&seq, "crossing", FRAMES);
     let out = dir.path().join("det.txt");
     let summary = run_ok(&[
         "detect",
@@ -73,7 +57,7 @@ fn motion_blobs_are_written_as_detections_on_the_walkers() {
 fn bad_motion_detector_options_are_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("crossing");
-    walkers(&seq, "crossing");
+    synth_walkers(&seq, "crossing", FRAMES);
     let out = dir.path().join("det.txt");
     let input = seq.join("img1");
     let err = run_user_error(&[

@@ -5,33 +5,18 @@
 
 use std::collections::BTreeSet;
 use std::fs;
-use std::path::Path;
 
 mod common;
-use common::{path_str, run_ok, run_user_error};
+use common::{path_str, run_ok, run_user_error, synth_walkers};
 use sillage::io::read_mot_rows;
 
 const FRAMES: u64 = 60;
-
-/// Writes a walkers crossing of `FRAMES` frames into `seq` (img1/, gt/gt.txt, seqinfo.ini).
-fn walkers_crossing(seq: &Path) {
-    run_ok(&[
-        "synth",
-        "walkers",
-        "--scenario",
-        "crossing",
-        "--frames",
-        &FRAMES.to_string(),
-        "--out",
-        path_str(seq),
-    ]);
-}
 
 #[test]
 fn a_walkers_crossing_is_tracked_and_benched() {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("crossing");
-    walkers_crossing(&seq);
+    synth_walkers(&seq, "crossing", FRAMES);
     let out = dir.path().join("t.txt");
     let summary = run_ok(&[
         "track",

@@ -36,3 +36,19 @@ pub fn run_user_error(args: &[&str]) -> String {
     assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
     stderr(&output)
 }
+
+/// Writes generated walkers of `scenario` (`sillage synth walkers`), `frames` long, into `seq`
+/// (img1/, gt/gt.txt, seqinfo.ini).
+#[allow(dead_code)] // not every test file needs walkers
+pub fn synth_walkers(seq: &Path, scenario: &str, frames: u64) {
+    run_ok(&[
+        "synth",
+        "walkers",
+        "--scenario",
+        scenario,
+        "--frames",
+        &frames.to_string(),
+        "--out",
+        path_str(seq),
+    ]);
+}
