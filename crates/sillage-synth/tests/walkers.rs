@@ -160,8 +160,13 @@ fn group_split_walkers_touch_then_part() {
 
 /// Runs the motion detector with its default parameters over the grey frames.
 fn blobs_per_frame(frames: &[WalkersFrame]) -> Vec<Vec<MotionBlob>> {
+    blobs_with(frames, &MotionParams::default())
+}
+
+/// Runs the motion detector with `params` over the grey frames.
+fn blobs_with(frames: &[WalkersFrame], params: &MotionParams) -> Vec<Vec<MotionBlob>> {
     let (width, height) = frames[0].grey.dimensions();
-    let mut detector = MotionDetector::new(&MotionParams::default(), width, height).unwrap();
+    let mut detector = MotionDetector::new(params, width, height).unwrap();
     frames
         .iter()
         .map(|frame| {
@@ -222,39 +227,68 @@ fn the_motion_detector_finds_each_isolated_walker() {
     }
 }
 
+/// The frames where walkers 1 and 2 of `frames` touch, both at least 90 % visible, with
+/// their true boxes.
+fn together_pairs(frames: &[WalkersFrame]) -> Vec<(usize, BoundingBox, BoundingBox)> {
+    frames
+        .iter()
+        .enumerate()
+        .filter_map(|(i, frame)| {
+            let (a, b) = (walker(frame, 1)?, walker(frame, 2)?);
+            let together = gap(&truth_box(a), &truth_box(b)) <= 0.0;
+            (together && a.visibility >= 0.9 && b.visibility >= 0.9)
+                .then(|| (i, truth_box(a), truth_box(b)))
+        })
+        .collect()
+}
+
 #[test]
-fn the_motion_detector_sees_the_group_as_one_blob_before_the_split() {
-    let params = group_split();
-    let frames = frames(params.clone());
-    let blobs = blobs_per_frame(&frames);
-    let (mut one_blob, mut total) = (0, 0);
-    for (frame, blobs) in frames.iter().zip(&blobs) {
-        let (Some(a), Some(b)) = (walker(frame, 1), walker(frame, 2)) else {
-            continue;
-        };
-        let together = gap(&truth_box(a), &truth_box(b)) <= 0.0;
-        if !together || a.visibility < 0.9 || b.visibility < 0.9 {
-            continue;
-        }
-        total += 1;
-        // One blob holds most of both boxes.
-        let covers = |blob: &MotionBlob, t: &WalkerTruth| {
-            let (tb, bb) = (truth_box(t), blob_box(blob));
-            let w = (tb.left_px + tb.width_px).min(bb.left_px + bb.width_px)
-                - tb.left_px.max(bb.left_px);
-            let h =
-                (tb.top_px + tb.height_px).min(bb.top_px + bb.height_px) - tb.top_px.max(bb.top_px);
-            w.max(0.0) * h.max(0.0) >= 0.8 * tb.width_px * tb.height_px
-        };
-        if blobs.iter().any(|blob| covers(blob, a) && covers(blob, b)) {
-            one_blob += 1;
-        }
-    }
-    eprintln!("group split: one blob in {one_blob} of {total} together frames");
-    assert!(total >= 20, "{total} together frames");
+fn the_group_is_one_blob_of_the_mask_and_the_detector_cuts_it_into_its_walkers() {
+    let frames = frames(group_split());
+    let pairs = together_pairs(&frames);
+    assert!(pairs.len() >= 20, "{} together frames", pairs.len());
+    // Uncut, one blob holds most of both boxes: the group is one connected foreground.
+    let uncut = blobs_with(
+        &frames,
+        &MotionParams {
+            person_aspect: 0.0,
+            ..MotionParams::default()
+        },
+    );
+    let covers = |blob: &MotionBlob, tb: &BoundingBox| {
+        let bb = blob_box(blob);
+        let w =
+            (tb.left_px + tb.width_px).min(bb.left_px + bb.width_px) - tb.left_px.max(bb.left_px);
+        let h = (tb.top_px + tb.height_px).min(bb.top_px + bb.height_px) - tb.top_px.max(bb.top_px);
+        w.max(0.0) * h.max(0.0) >= 0.8 * tb.width_px * tb.height_px
+    };
+    let one_blob = pairs
+        .iter()
+        .filter(|(i, a, b)| {
+            uncut[*i]
+                .iter()
+                .any(|blob| covers(blob, a) && covers(blob, b))
+        })
+        .count();
+    // Cut (the default), each walker has its own blob.
+    let cut = blobs_per_frame(&frames);
+    let own_blob =
+        |i: usize, t: &BoundingBox| cut[i].iter().any(|b| box_iou(t, &blob_box(b)) >= 0.5);
+    let both_found = pairs
+        .iter()
+        .filter(|(i, a, b)| own_blob(*i, a) && own_blob(*i, b))
+        .count();
+    let total = pairs.len();
+    eprintln!(
+        "group: one blob uncut in {one_blob}, both walkers cut out in {both_found} of {total} together frames"
+    );
     assert!(
         one_blob as f64 >= 0.9 * total as f64,
         "one blob in {one_blob} of {total}"
+    );
+    assert!(
+        both_found as f64 >= 0.8 * total as f64,
+        "both cut out in {both_found} of {total}"
     );
 }
 

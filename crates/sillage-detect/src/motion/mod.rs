@@ -7,6 +7,7 @@
 
 mod blobs;
 mod mixture;
+mod split;
 
 use serde::{Deserialize, Serialize};
 use sillage_core::{Error, GrayImage, Image, Result};
@@ -18,6 +19,7 @@ pub use mixture::{
 };
 
 use blobs::{Grouping, group_components};
+use split::GroupSplit;
 
 /// Parameters of the motion detector; the defaults suit 768×576 street scenes (PETS 2009:
 /// chosen on its first 150 frames among a few settings of the gap, the disks, the blob size,
@@ -37,6 +39,12 @@ pub struct MotionParams {
     pub merge_gap_px: usize,
     /// Blobs below this area are dropped, px².
     pub min_blob_px: usize,
+    /// A blob wider than this × its height is a group of people side by side, cut into
+    /// people at the emptiest columns of its mask.
+    pub group_aspect: f64,
+    /// One person's width / height, which counts the people in a group (0: groups are not
+    /// cut).
+    pub person_aspect: f64,
 }
 
 impl Default for MotionParams {
@@ -48,6 +56,8 @@ impl Default for MotionParams {
             min_component_px: 20,
             merge_gap_px: 2,
             min_blob_px: 150,
+            group_aspect: 0.55,
+            person_aspect: 0.4,
         }
     }
 }
@@ -75,6 +85,22 @@ impl MotionParams {
                 "min_blob_px",
                 self.min_blob_px.to_string(),
                 "at least min_component_px: a blob is one or more components",
+            ));
+        }
+        if !(0.0..=2.0).contains(&self.person_aspect) {
+            return Err(Error::parameter(
+                "person_aspect",
+                self.person_aspect.to_string(),
+                "0 (no cut) to 2",
+            ));
+        }
+        if self.person_aspect > 0.0
+            && !(self.group_aspect >= self.person_aspect && self.group_aspect <= 10.0)
+        {
+            return Err(Error::parameter(
+                "group_aspect",
+                self.group_aspect.to_string(),
+                "person_aspect to 10: a group is wider than one person",
             ));
         }
         Ok(())
@@ -122,7 +148,7 @@ impl MotionDetector {
     }
 
     /// Learns `frame` and writes its moving blobs into `out` (cleared first), in raster order
-    /// of their first pixel. The first frame only starts the model: it has no blobs.
+    /// of their first pixel (a group's people left to right, in its place). The first frame only starts the model: it has no blobs.
     pub fn detect(&mut self, frame: &GrayImage, out: &mut Vec<MotionBlob>) -> Result<()> {
         out.clear();
         let first = self.background.frames_seen() == 0;
@@ -139,6 +165,12 @@ impl MotionDetector {
             min_blob_px: self.params.min_blob_px,
         };
         group_components(&self.components, &self.foreground, grouping, out);
+        GroupSplit {
+            group_aspect: self.params.group_aspect,
+            person_aspect: self.params.person_aspect,
+            min_blob_px: self.params.min_blob_px,
+        }
+        .apply(out);
         Ok(())
     }
 
