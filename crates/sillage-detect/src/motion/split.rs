@@ -46,7 +46,10 @@ impl GroupSplit {
         if self.person_aspect <= 0.0 || w <= self.group_aspect * h {
             return 1;
         }
-        ((w / (self.person_aspect * h)).round() as usize).max(2)
+        // At least 2 columns a person, so that cuts stay apart and inside the blob.
+        ((w / (self.person_aspect * h)).round() as usize)
+            .max(2)
+            .min(blob.bbox.width() / 2)
     }
 
     /// `blob` cut into `people` pieces at the emptiest columns near equal shares.
@@ -218,6 +221,21 @@ mod tests {
         let mut blobs = vec![pair.clone()];
         off.apply(&mut blobs);
         assert_eq!(blobs, [pair]);
+    }
+
+    #[test]
+    fn a_flat_blob_and_a_tiny_person_aspect_give_pieces_inside_the_blob() {
+        let strip = blob(100, 3, &[(0, 0, 100, 3)]);
+        let tiny = GroupSplit {
+            person_aspect: 0.01,
+            group_aspect: 0.02,
+            min_blob_px: 1,
+        };
+        let mut blobs = vec![strip];
+        tiny.apply(&mut blobs);
+        assert_eq!(blobs.len(), 50);
+        assert!(blobs.windows(2).all(|p| p[0].bbox.x1 <= p[1].bbox.x0));
+        assert_eq!(blobs.iter().map(|b| b.area).sum::<usize>(), 300);
     }
 
     #[test]
