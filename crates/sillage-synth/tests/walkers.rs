@@ -247,14 +247,8 @@ fn the_group_is_one_blob_of_the_mask_and_the_detector_cuts_it_into_its_walkers()
     let frames = frames(group_split());
     let pairs = together_pairs(&frames);
     assert!(pairs.len() >= 20, "{} together frames", pairs.len());
-    // Uncut, one blob holds most of both boxes: the group is one connected foreground.
-    let uncut = blobs_with(
-        &frames,
-        &MotionParams {
-            person_aspect: 0.0,
-            ..MotionParams::default()
-        },
-    );
+    // Uncut (the default), one blob holds most of both boxes: one connected foreground.
+    let uncut = blobs_per_frame(&frames);
     let covers = |blob: &MotionBlob, tb: &BoundingBox| {
         let bb = blob_box(blob);
         let w =
@@ -270,8 +264,14 @@ fn the_group_is_one_blob_of_the_mask_and_the_detector_cuts_it_into_its_walkers()
                 .any(|blob| covers(blob, a) && covers(blob, b))
         })
         .count();
-    // Cut (the default), each walker has its own blob.
-    let cut = blobs_per_frame(&frames);
+    // Cut (`person_aspect` 0.4), each walker has its own blob.
+    let cut = blobs_with(
+        &frames,
+        &MotionParams {
+            person_aspect: 0.4,
+            ..MotionParams::default()
+        },
+    );
     let own_blob =
         |i: usize, t: &BoundingBox| cut[i].iter().any(|b| box_iou(t, &blob_box(b)) >= 0.5);
     let both_found = pairs
