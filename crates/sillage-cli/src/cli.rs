@@ -763,9 +763,14 @@ pub struct BenchSiftpfArgs {
     /// Use the first N frames of each sequence.
     #[arg(long, value_name = "N")]
     pub max_frames: Option<usize>,
-    /// Random seed of the particles (one run per selection: the tracker is deterministic).
+    /// Random seed of the particles, of the first run (the tracker is deterministic for a
+    /// seed).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Runs per selection, with seeds `seed`, `seed + 1`, …; the table gives each score's
+    /// median over the runs and in how many runs each selection was best on M̄.
+    #[arg(long, default_value_t = 1, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub runs: u64,
     /// Ground plane, as `sillage track siftpf --ground-plane`.
     #[arg(long, value_name = "FILE")]
     pub ground_plane: Option<PathBuf>,

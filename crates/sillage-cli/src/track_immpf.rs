@@ -28,8 +28,8 @@ use crate::progress::FrameProgress;
 const MOTION_BOOTSTRAP_FRAMES: usize = 20;
 
 /// With a ground plane, a blob is cut into people by the detector when wider than this × its
-/// height (`MotionParams::group_aspect`), unless the configuration gives another value than
-/// the detector's default.
+/// height (`MotionParams::group_aspect`), unless the configuration file or `--set` gives the
+/// key.
 const GROUND_GROUP_ASPECT: f64 = 1.0;
 
 /// The motion detector's parameters the pedestrian tracker runs with by default: the
@@ -69,13 +69,18 @@ pub fn load_params(args: &TrackImmpfArgs) -> Result<(PedestrianParams, MotionPar
             }
         }
     }
-    let mut config: ConfigFile = match &args.config {
-        Some(path) => read_toml_file(path)?,
-        None => ConfigFile::default(),
+    let (mut config, file_sets_group_aspect) = match &args.config {
+        Some(path) => {
+            let keys: toml::Table = read_toml_file(path)?;
+            let sets = keys
+                .get("motion_detector")
+                .and_then(|m| m.get("group_aspect"))
+                .is_some();
+            (read_toml_file::<ConfigFile>(path)?, sets)
+        }
+        None => (ConfigFile::default(), false),
     };
-    if args.ground_plane.is_some()
-        && config.motion_detector.group_aspect == MotionParams::default().group_aspect
-    {
+    if args.ground_plane.is_some() && !file_sets_group_aspect {
         config.motion_detector.group_aspect = GROUND_GROUP_ASPECT;
     }
     for assignment in &args.overrides {
@@ -306,5 +311,24 @@ mod tests {
             "motion_detector.group_aspect=0.7",
         ];
         assert_eq!(group_aspect(&set), 0.7);
+        // A configuration file that gives the key, even at the detector's default, is obeyed.
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("c.toml");
+        let value = MotionParams::default().group_aspect;
+        std::fs::write(
+            &file,
+            format!("[motion_detector]\ngroup_aspect = {value}\n"),
+        )
+        .unwrap();
+        let path = file.to_str().unwrap();
+        assert_eq!(
+            group_aspect(&["--ground-plane", "g.toml", "--config", path]),
+            value
+        );
+        std::fs::write(&file, "[motion_detector]\nmin_blob_px = 150\n").unwrap();
+        assert_eq!(
+            group_aspect(&["--ground-plane", "g.toml", "--config", path]),
+            GROUND_GROUP_ASPECT
+        );
     }
 }

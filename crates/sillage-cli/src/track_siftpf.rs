@@ -117,6 +117,7 @@ pub fn track_sequence(
             .map(|b| DetectedObject {
                 bbox: b.bbox,
                 mask: b.mask,
+                cut_from: b.cut_from,
             })
             .collect();
         let tick = Instant::now();

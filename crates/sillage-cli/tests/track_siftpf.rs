@@ -91,6 +91,50 @@ fn a_walkers_crossing_is_tracked_and_benched() {
 }
 
 #[test]
+fn several_runs_give_the_median_of_each_score_and_count_the_best_selection() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("crossing");
+    synth_walkers(&seq, "crossing", FRAMES);
+    let bench = |extra: &[&str]| {
+        let mut args = vec![
+            "bench",
+            "siftpf",
+            path_str(&seq),
+            "--selections",
+            "whole-object,reliability",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let report: serde_json::Value = serde_json::from_str(&run_ok(&args)).unwrap();
+        report["sequences"].as_array().unwrap().clone()
+    };
+    let seed1 = bench(&["--seed", "1"]);
+    let seed2 = bench(&["--seed", "2"]);
+    let both = bench(&["--seed", "1", "--runs", "2"]);
+    assert_eq!(both.len(), 2);
+    let value = |row: &serde_json::Value, key: &str| row[key].as_f64().unwrap();
+    for k in 0..2 {
+        assert_eq!(both[k]["runs"].as_u64(), Some(2));
+        // The median of two runs is their mean.
+        for key in ["mean", "mota", "idf1", "hota"] {
+            let expected = 0.5 * (value(&seed1[k], key) + value(&seed2[k], key));
+            assert!(
+                (value(&both[k], key) - expected).abs() < 1e-9,
+                "{key}: {} against {expected}",
+                both[k][key]
+            );
+        }
+        let wins =
+            seed1[k]["best_mean_in"].as_u64().unwrap() + seed2[k]["best_mean_in"].as_u64().unwrap();
+        assert_eq!(both[k]["best_mean_in"].as_u64(), Some(wins));
+    }
+    // In each run, at least one selection has the best M̄.
+    for rows in [&seed1, &seed2] {
+        assert!(rows.iter().any(|r| r["best_mean_in"].as_u64() == Some(1)));
+    }
+}
+
+#[test]
 fn bad_options_and_folders_are_refused_with_the_problem_named() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("t.txt");

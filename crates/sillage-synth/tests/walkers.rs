@@ -247,8 +247,14 @@ fn the_group_is_one_blob_of_the_mask_and_the_detector_cuts_it_into_its_walkers()
     let frames = frames(group_split());
     let pairs = together_pairs(&frames);
     assert!(pairs.len() >= 20, "{} together frames", pairs.len());
-    // Uncut (the default), one blob holds most of both boxes: one connected foreground.
-    let uncut = blobs_per_frame(&frames);
+    // Uncut (`person_aspect` 0), one blob holds most of both boxes: one connected foreground.
+    let uncut = blobs_with(
+        &frames,
+        &MotionParams {
+            person_aspect: 0.0,
+            ..MotionParams::default()
+        },
+    );
     let covers = |blob: &MotionBlob, tb: &BoundingBox| {
         let bb = blob_box(blob);
         let w =
@@ -264,19 +270,21 @@ fn the_group_is_one_blob_of_the_mask_and_the_detector_cuts_it_into_its_walkers()
                 .any(|blob| covers(blob, a) && covers(blob, b))
         })
         .count();
-    // Cut (`person_aspect` 0.4), each walker has its own blob.
-    let cut = blobs_with(
-        &frames,
-        &MotionParams {
-            person_aspect: 0.4,
-            ..MotionParams::default()
-        },
-    );
-    let own_blob =
-        |i: usize, t: &BoundingBox| cut[i].iter().any(|b| box_iou(t, &blob_box(b)) >= 0.5);
+    // Cut (the default), each walker has its own blob, and both pieces name the group blob
+    // they were cut from.
+    let cut = blobs_per_frame(&frames);
+    let own_blob = |i: usize, t: &BoundingBox| {
+        cut[i]
+            .iter()
+            .find(|b| box_iou(t, &blob_box(b)) >= 0.5)
+            .map(|b| b.cut_from)
+    };
     let both_found = pairs
         .iter()
-        .filter(|(i, a, b)| own_blob(*i, a) && own_blob(*i, b))
+        .filter(|(i, a, b)| match (own_blob(*i, a), own_blob(*i, b)) {
+            (Some(Some(ga)), Some(Some(gb))) => ga == gb,
+            _ => false,
+        })
         .count();
     let total = pairs.len();
     eprintln!(

@@ -30,6 +30,7 @@ fn track(frames: &[WalkersFrame], seed: u64) -> Vec<SiftPfEstimate> {
             .map(|b| DetectedObject {
                 bbox: b.bbox,
                 mask: b.mask,
+                cut_from: b.cut_from,
             })
             .collect();
         let found = tracker

@@ -16,6 +16,10 @@ pub struct MotionBlob {
     pub centroid: Point2,
     /// The cleaned foreground inside `bbox` (`bbox.width() × bbox.height()`).
     pub mask: Image<bool>,
+    /// For a piece of a group cut into people, the group blob's box (shared by all its
+    /// pieces); `None` for a blob that was not cut. A tracker whose objects contradict the
+    /// cut can join the pieces back.
+    pub cut_from: Option<PixelBox>,
 }
 
 /// How components are grouped into blobs.
@@ -80,6 +84,7 @@ pub(crate) fn group_components(
                 area,
                 centroid: Point2::new(sx / area as f64, sy / area as f64),
                 mask: crop(foreground, &bbox),
+                cut_from: None,
             }),
     );
 }

@@ -97,7 +97,9 @@ fn smoothed_column_counts(mask: &Image<bool>, radius: usize) -> Vec<usize> {
 
 /// The part of `blob` in mask columns `x0..x1`, tightened to its foreground; `None` if empty.
 fn piece(blob: &MotionBlob, x0: usize, x1: usize) -> Option<MotionBlob> {
-    let (mut tight, mut area, mut sx, mut sy) = (None::<PixelBox>, 0usize, 0.0, 0.0);
+    // Bounds of the piece's pixels in mask coordinates (inclusive), their count and sums.
+    let (mut lo, mut hi) = ((usize::MAX, usize::MAX), (0, 0));
+    let (mut area, mut sx, mut sy) = (0usize, 0.0, 0.0);
     for y in 0..blob.mask.height() {
         for (x, _) in blob.mask.row(y)[x0..x1]
             .iter()
@@ -105,19 +107,22 @@ fn piece(blob: &MotionBlob, x0: usize, x1: usize) -> Option<MotionBlob> {
             .filter(|(_, on)| **on)
         {
             let x = x0 + x;
-            let pixel = PixelBox {
-                x0: x,
-                y0: y,
-                x1: x + 1,
-                y1: y + 1,
-            };
-            tight = Some(tight.map_or(pixel, |t| t.union(&pixel)));
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
             area += 1;
             sx += x as f64;
             sy += y as f64;
         }
     }
-    let local = tight?;
+    if area == 0 {
+        return None;
+    }
+    let local = PixelBox {
+        x0: lo.0,
+        y0: lo.1,
+        x1: hi.0 + 1,
+        y1: hi.1 + 1,
+    };
     let mask = Image::from_vec(
         local.width(),
         local.height(),
@@ -137,6 +142,7 @@ fn piece(blob: &MotionBlob, x0: usize, x1: usize) -> Option<MotionBlob> {
         area,
         centroid: Point2::new(bx as f64 + sx / area as f64, by as f64 + sy / area as f64),
         mask,
+        cut_from: Some(blob.bbox),
     })
 }
 
@@ -165,6 +171,7 @@ mod tests {
             area,
             centroid: Point2::new(0.0, 0.0),
             mask,
+            cut_from: None,
         }
     }
 
@@ -192,6 +199,13 @@ mod tests {
         );
         assert_eq!(blobs[1].bbox.y0, 55, "the right body starts 5 rows lower");
         assert_eq!(blobs[1].mask.dimensions(), (142 - cut, 45));
+        let group = PixelBox {
+            x0: 100,
+            y0: 50,
+            x1: 142,
+            y1: 100,
+        };
+        assert!(blobs.iter().all(|b| b.cut_from == Some(group)));
         let on = blobs.iter().map(|b| b.area).sum::<usize>();
         assert_eq!(
             on,

@@ -15,6 +15,9 @@ pub struct DetectedObject {
     pub bbox: PixelBox,
     /// Its motion pixels inside `bbox` (`bbox.width() × bbox.height()`).
     pub mask: Image<bool>,
+    /// For a piece of a blob the detector cut into people, that blob's box (shared by its
+    /// pieces); `None` otherwise.
+    pub cut_from: Option<PixelBox>,
 }
 
 impl DetectedObject {
@@ -26,7 +29,34 @@ impl DetectedObject {
             vec![true; bbox.width() * bbox.height()],
         )
         .expect("the mask has the box's size");
-        Self { bbox, mask }
+        Self {
+            bbox,
+            mask,
+            cut_from: None,
+        }
+    }
+
+    /// One detection made of `pieces`: the union of their boxes and motion pixels, uncut.
+    pub fn joined(pieces: &[&DetectedObject]) -> Self {
+        let bbox = pieces
+            .iter()
+            .map(|p| p.bbox)
+            .reduce(|a, b| a.union(&b))
+            .unwrap_or_default();
+        let mut mask = Image::new(bbox.width(), bbox.height());
+        for p in pieces {
+            for y in 0..p.bbox.height() {
+                let row = &mut mask.row_mut(p.bbox.y0 - bbox.y0 + y)[p.bbox.x0 - bbox.x0..];
+                for (m, &on) in row.iter_mut().zip(p.mask.row(y)) {
+                    *m |= on;
+                }
+            }
+        }
+        Self {
+            bbox,
+            mask,
+            cut_from: None,
+        }
     }
 
     /// True when `p` falls on one of the detection's motion pixels ("geometrically belongs").
@@ -82,6 +112,15 @@ impl LinkMatrix {
     /// Overwrites `s(i, j)` (an object without features is scored by box overlap).
     pub fn set_score(&mut self, i: usize, j: usize, score: f64) {
         self.scores[i * self.cols + j] = score;
+    }
+
+    /// True when detection `j` holds a large part of object `i`'s features: a score of at
+    /// least `min_link` and at least `min_share` of the object's total. An object with large
+    /// parts on two detections is split across them (§2.3).
+    pub fn holds_part(&self, i: usize, j: usize, min_link: f64, min_share: f64) -> bool {
+        let total: f64 = (0..self.cols).map(|k| self.score(i, k)).sum();
+        let s = self.score(i, j);
+        s > 0.0 && s >= min_link && s >= min_share * total
     }
 
     /// Objects (rows).

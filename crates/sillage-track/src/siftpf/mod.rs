@@ -8,7 +8,8 @@
 //! - feature selection (§2.1, [`FeatureSelector`]), in the paper's three configurations of
 //!   §3.1.1 ([`FeatureSelection`]);
 //! - the per-feature particle filter (§2.2, [`TrackedFeature`]);
-//! - the link-score matrix of Eq. (6) and the four cases of §2.3 ([`LinkMatrix`]);
+//! - the link-score matrix of Eq. (6) and the four cases of §2.3 ([`LinkMatrix`]), with
+//!   the detector's cuts of groups into people joined back where an object straddles one;
 //! - occlusion management by SIFT matching, dominant colours and learned size and speed
 //!   (§2.4, [`resume_score`]);
 //! - validation of new objects (§2.5, [`is_object_of_interest`]);
@@ -16,6 +17,7 @@
 
 mod association;
 mod coherence;
+mod cuts;
 mod feature;
 mod object;
 mod occlusion;

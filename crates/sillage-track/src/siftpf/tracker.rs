@@ -15,6 +15,7 @@ use sillage_image::{DominantColours, SiftDetector, SiftKeypoint};
 
 use super::association::{DetectedObject, LinkMatrix};
 use super::coherence::WorldScale;
+use super::cuts::join_straddled_cuts;
 use super::feature::{FeatureFate, FeatureFrame, TrackedFeature};
 use super::object::{HistoryEntry, ObjectState, TrackedObject};
 use super::occlusion::{ResumeCandidate, resume_pairs};
@@ -133,6 +134,11 @@ impl SiftPfTracker {
         check_sizes(&input)?;
         self.sift.analyse(input.grey)?;
         self.follow_features(&input);
+        let joined = self.join_straddled_cuts(input.detections);
+        let input = SiftPfFrame {
+            detections: joined.as_deref().unwrap_or(input.detections),
+            ..input
+        };
         let mut links = self.associate(&input);
         let mut free = self.apply_links(&input, &mut links);
         self.resume_occluded(&input, &mut free);
@@ -165,30 +171,47 @@ impl SiftPfTracker {
             });
     }
 
-    /// §2.3: the link matrix of the active objects against the detections, and the case of
-    /// each active object (in the order of `self.objects`, occluded ones as `Link::None`).
-    fn associate(&self, input: &SiftPfFrame<'_>) -> Vec<Link> {
+    /// The indices of the active objects and their link scores against `detections`
+    /// (Eq. 6); an object without features is scored by box overlap.
+    fn link_scores(&self, detections: &[DetectedObject]) -> (Vec<usize>, LinkMatrix) {
         let active: Vec<usize> = (0..self.objects.len())
             .filter(|&i| self.objects[i].is_active())
             .collect();
         let feature_lists: Vec<Vec<(Point2, f64)>> = active
             .iter()
-            .map(|&i| {
-                self.objects[i]
-                    .features
-                    .iter()
-                    .map(|f| (f.pos_px(), f.reliability()))
-                    .collect()
-            })
+            .map(|&i| scored_features(&self.objects[i]))
             .collect();
-        let mut scores = LinkMatrix::new(feature_lists.iter().map(Vec::as_slice), input.detections);
+        let mut scores = LinkMatrix::new(feature_lists.iter().map(Vec::as_slice), detections);
         for (row, &i) in active.iter().enumerate() {
             if self.objects[i].features.is_empty() {
-                for (j, d) in input.detections.iter().enumerate() {
+                for (j, d) in detections.iter().enumerate() {
                     scores.set_score(row, j, self.objects[i].bbox.iou(&person_box(d)));
                 }
             }
         }
+        (active, scores)
+    }
+
+    /// The detections with the cuts that an object's features straddle joined back
+    /// ([`super::cuts`]); `None` when every cut stands.
+    fn join_straddled_cuts(&self, detections: &[DetectedObject]) -> Option<Vec<DetectedObject>> {
+        if detections.iter().all(|d| d.cut_from.is_none()) {
+            return None;
+        }
+        let with_features: Vec<Vec<(Point2, f64)>> = self
+            .objects
+            .iter()
+            .filter(|o| o.is_active() && !o.features.is_empty())
+            .map(scored_features)
+            .collect();
+        let scores = LinkMatrix::new(with_features.iter().map(Vec::as_slice), detections);
+        join_straddled_cuts(detections, &scores, self.params.association.min_link_score)
+    }
+
+    /// §2.3: the link matrix of the active objects against the detections, and the case of
+    /// each active object (in the order of `self.objects`, occluded ones as `Link::None`).
+    fn associate(&self, input: &SiftPfFrame<'_>) -> Vec<Link> {
+        let (active, scores) = self.link_scores(input.detections);
         let min_link = self.params.association.min_link_score;
         let targets = scores.targets(min_link);
         let mut members = vec![0usize; input.detections.len()];
@@ -202,12 +225,9 @@ impl SiftPfTracker {
                 links[i] = Link::Merged(j);
                 continue;
             }
-            let total: f64 = (0..scores.cols()).map(|k| scores.score(row, k)).sum();
+            let min_share = self.params.association.split_min_share;
             let split = (0..scores.cols()).any(|k| {
-                k != j
-                    && members[k] == 0
-                    && scores.score(row, k) >= min_link
-                    && scores.score(row, k) >= self.params.association.split_min_share * total
+                k != j && members[k] == 0 && scores.holds_part(row, k, min_link, min_share)
             });
             links[i] = if split && !self.objects[i].has_merged {
                 Link::GroupSplit
@@ -598,6 +618,15 @@ impl SiftPfTracker {
         );
         out
     }
+}
+
+/// An object's features as Eq. (6) scores them: positions and reliabilities.
+fn scored_features(object: &TrackedObject) -> Vec<(Point2, f64)> {
+    object
+        .features
+        .iter()
+        .map(|f| (f.pos_px(), f.reliability()))
+        .collect()
 }
 
 /// How far (in box widths) the centre of `estimated` lies from that of `predicted`.
