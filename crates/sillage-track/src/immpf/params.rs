@@ -194,7 +194,8 @@ pub struct PedestrianParams {
     /// velocity, within half a box height), takes the dead tracker's identity back; default
     /// 20, about 3 s at 7 frames/s (not in the paper: it reduces the identities a person lost
     /// in a crowd receives; on PETS 2009 S2.L1, 15 to 40 frames gave ATA 0.28-0.29 where 10
-    /// gave 0.25, docs/immpf.md). 0 disables it.
+    /// gave 0.25, docs/immpf.md). 0 disables it, and the hand-down of an identity to a
+    /// tracker born on the dying one's path shortly before its death with it.
     pub revive_frames: u32,
     /// A birth candidate (motion blob or detection) is explained by a tracker whose box it
     /// overlaps by at least this IoU; default 0.2.

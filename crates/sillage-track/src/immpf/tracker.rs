@@ -3,6 +3,8 @@
 //! motion histograms (§4.3) or, without images, by the detections, and removed when the mean
 //! likelihood of its particles stays low for some frames (§5.3).
 
+use std::collections::VecDeque;
+
 use rayon::prelude::*;
 use sillage_core::{Error, FrameIndex, Point2, Result, TrackId, Vec2};
 use sillage_filter::{
@@ -59,6 +61,9 @@ const SUPPORT_IOU: f64 = 0.1;
 /// One live tracker.
 #[derive(Debug, Clone)]
 struct Track {
+    /// The identity it reports: its filter's, or that of a tracker it took over
+    /// ([`PedestrianTracker::hand_down`]).
+    id: TrackId,
     filter: ImmParticleFilter,
     appearance: Option<Appearance>,
     /// Width and height, px, used where the sizing has no ground plane.
@@ -73,6 +78,18 @@ struct Track {
     age: u32,
     /// Estimates held until the tracker is confirmed (`confirm_frames`).
     held: Vec<PedestrianEstimate>,
+    /// Its foot point in its last `confirm_frames` frames, oldest first.
+    recent_feet: VecDeque<(FrameIndex, Point2)>,
+}
+
+impl Track {
+    /// Records this frame's foot point, keeping the last `keep`.
+    fn remember_foot(&mut self, frame: FrameIndex, keep: u32) {
+        if self.recent_feet.len() >= keep.max(1) as usize {
+            self.recent_feet.pop_front();
+        }
+        self.recent_feet.push_back((frame, self.bbox.foot()));
+    }
 }
 
 /// The pedestrian IMM-PF tracker. Each filter draws from its own stream
@@ -93,14 +110,17 @@ pub struct PedestrianTracker {
 }
 
 /// A confirmed tracker that died recently: where it was going, so that a birth on its way
-/// takes its identity back.
-#[derive(Debug, Clone, Copy)]
+/// takes its identity back, and where it was in its last frames, so that a tracker born on
+/// its person shortly before it died takes it over.
+#[derive(Debug, Clone)]
 struct Departed {
     track_id: TrackId,
     foot: Point2,
     vel_px_per_frame: Vec2,
     /// Its last frame.
     frame: FrameIndex,
+    /// Its foot point in its last frames, oldest first.
+    recent_feet: Vec<(FrameIndex, Point2)>,
 }
 
 impl Departed {
@@ -108,10 +128,11 @@ impl Departed {
     fn of(track: &Track, frame: FrameIndex) -> Self {
         let mean = track.filter.estimate().mean;
         Self {
-            track_id: track.filter.track_id(),
+            track_id: track.id,
             foot: track.bbox.foot(),
             vel_px_per_frame: Vec2::new(mean.at(2), mean.at(3)),
             frame,
+            recent_feet: track.recent_feet.iter().copied().collect(),
         }
     }
 }
@@ -188,6 +209,7 @@ impl PedestrianTracker {
         let coasting_hidden = frame.cues.is_none() && !self.params.detection.report_coasting;
         for track in &mut self.tracks {
             track.age += 1;
+            track.remember_foot(frame.frame, confirm);
             let observed = track.age == 1 || track.matched.is_some();
             if track.age < confirm {
                 if observed || !coasting_hidden {
@@ -393,6 +415,34 @@ impl PedestrianTracker {
             }
             keep
         });
+        self.hand_down(frame);
+    }
+
+    /// A tracker not yet confirmed takes over the identity of a confirmed one that died at
+    /// `frame` when it was born on that tracker's path: its first foot point lies within half
+    /// its height of the dead tracker's foot point in the same frame. The dead tracker had
+    /// drifted off its person (onto a neighbour, in a group), the person was born again
+    /// beside it, and the identity goes on with the person. The heir is reported from this
+    /// frame; its earlier frames, which the dead tracker reported under that identity, are
+    /// dropped. Not in the paper; off with `revive_frames = 0`.
+    fn hand_down(&mut self, frame: FrameIndex) {
+        let confirm = self.params.confirm_frames;
+        let mut k = 0;
+        while k < self.departed.len() {
+            let heir = (self.departed[k].frame == frame)
+                .then(|| heir_of(&self.departed[k], &self.tracks, confirm))
+                .flatten();
+            match heir {
+                Some(i) => {
+                    let d = self.departed.swap_remove(k);
+                    let track = &mut self.tracks[i];
+                    track.id = d.track_id;
+                    track.held.clear();
+                    track.age = confirm;
+                }
+                None => k += 1,
+            }
+        }
     }
 
     /// Starts a tracker on every candidate that no live tracker explains.
@@ -454,6 +504,7 @@ impl PedestrianTracker {
                     }
                 };
                 self.tracks.push(Track {
+                    id: track_id,
                     filter: self.spec.spawn(track_id, &spread),
                     appearance,
                     size_px: (person.width_px, person.height_px),
@@ -463,6 +514,7 @@ impl PedestrianTracker {
                     bbox: person,
                     age,
                     held: Vec::new(),
+                    recent_feet: VecDeque::new(),
                 });
             }
         }
@@ -492,6 +544,33 @@ impl PedestrianTracker {
     }
 }
 
+/// The index of the unconfirmed tracker of `tracks` (younger than `confirm` frames) that
+/// may take over `departed`'s identity ([`nearest_heir`]).
+fn heir_of(departed: &Departed, tracks: &[Track], confirm: u32) -> Option<usize> {
+    let young = tracks.iter().enumerate().filter_map(|(i, t)| {
+        let first = *t.recent_feet.front()?;
+        (t.age < confirm).then_some((i, first, t.bbox.height_px))
+    });
+    nearest_heir(&departed.recent_feet, young)
+}
+
+/// Among `young` trackers (index, first frame and foot point, box height), the one whose
+/// first foot point lies nearest to `path`'s foot point (a dead tracker's last frames) in
+/// that same frame, within half its height; none when the path does not reach that frame.
+fn nearest_heir(
+    path: &[(FrameIndex, Point2)],
+    young: impl Iterator<Item = (usize, (FrameIndex, Point2), f64)>,
+) -> Option<usize> {
+    young
+        .filter_map(|(i, (born, foot), height)| {
+            let &(_, then) = path.iter().find(|(f, _)| *f == born)?;
+            let distance = (then - foot).norm();
+            (distance <= 0.5 * height).then_some((i, distance))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+}
+
 /// A tracker's estimate in `frame`.
 fn estimate_of(track: &Track, frame: FrameIndex, models: usize) -> PedestrianEstimate {
     let mut model_weights = vec![0.0; models];
@@ -499,7 +578,7 @@ fn estimate_of(track: &Track, frame: FrameIndex, models: usize) -> PedestrianEst
     let mean = track.filter.estimate().mean;
     PedestrianEstimate {
         frame,
-        track_id: track.filter.track_id(),
+        track_id: track.id,
         bbox: track.bbox,
         vel_px_per_frame: Vec2::new(mean.at(2), mean.at(3)),
         model_weights,
@@ -533,5 +612,32 @@ impl CompetingMotion for PedestrianMotion {
         normals: &mut sillage_filter::Normals<'_>,
     ) {
         self.advance_particle(columns, i, normals);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_heir_is_the_young_tracker_born_on_the_dead_ones_path() {
+        // The dead tracker walked right 2 px a frame over frames 10-14.
+        let path: Vec<(FrameIndex, Point2)> = (10..15)
+            .map(|f| (f, Point2::new(100.0 + 2.0 * (f - 10) as f64, 200.0)))
+            .collect();
+        let young = |list: &[(usize, FrameIndex, f64, f64)]| {
+            list.iter()
+                .map(|&(i, born, x, height)| (i, (born, Point2::new(x, 200.0)), height))
+                .collect::<Vec<_>>()
+        };
+        // Born at frame 12 (the dead one at x = 104): 30 px away with a 70 px box is
+        // within half its height, 40 px is not; the nearer of two wins.
+        let pick =
+            |list: &[(usize, FrameIndex, f64, f64)]| nearest_heir(&path, young(list).into_iter());
+        assert_eq!(pick(&[(3, 12, 134.0, 70.0)]), Some(3));
+        assert_eq!(pick(&[(3, 12, 144.0, 70.0)]), None);
+        assert_eq!(pick(&[(3, 12, 134.0, 70.0), (5, 13, 110.0, 70.0)]), Some(5));
+        // Born before the path's frames kept: no comparison, no heir.
+        assert_eq!(pick(&[(3, 8, 100.0, 70.0)]), None);
     }
 }
