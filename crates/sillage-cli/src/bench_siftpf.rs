@@ -161,6 +161,14 @@ struct Report {
 
 /// `sillage bench siftpf SEQ... [--selections ...]`.
 pub fn run(args: &BenchSiftpfArgs) -> Result<()> {
+    let last_seed = args.seed.checked_add(args.runs - 1).with_context(|| {
+        format!(
+            "--seed {} with --runs {} passes the largest seed, {}: give a smaller --seed",
+            args.seed,
+            args.runs,
+            u64::MAX
+        )
+    })?;
     let config = SiftPfConfig::load(args.config.as_deref(), &args.overrides, None)?;
     let selections = args
         .selections
@@ -182,7 +190,7 @@ pub fn run(args: &BenchSiftpfArgs) -> Result<()> {
     let mut rows = Vec::new();
     for sequence in &sequences {
         let mut of_sequence = Vec::new();
-        for seed in args.seed..args.seed + args.runs {
+        for seed in args.seed..=last_seed {
             let mut of_run = Vec::new();
             for &selection in &selections {
                 let mut config = config.clone();

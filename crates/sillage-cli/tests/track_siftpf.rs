@@ -156,6 +156,16 @@ fn bad_options_and_folders_are_refused_with_the_problem_named() {
     );
     let message = track(&["--set", "tracker.filter.particles=0"]);
     assert!(message.contains("tracker.filter.particles"), "{message}");
+    let message = run_user_error(&[
+        "bench",
+        "siftpf",
+        path_str(&empty),
+        "--seed",
+        "18446744073709551615",
+        "--runs",
+        "2",
+    ]);
+    assert!(message.contains("--seed"), "{message}");
     let message = run_user_error(&["bench", "siftpf", path_str(&empty), "--selections", "best"]);
     assert!(
         message.contains("best") && message.contains("reliability"),
