@@ -12,17 +12,18 @@ use sillage_image::PixelBox;
 use super::association::{DetectedObject, LinkMatrix};
 
 /// The detections with every cut straddled by an object joined back, or `None` when no
-/// object straddles a cut. `scores` are the link scores of the objects (rows) that have
-/// features against `detections`; an object straddles a cut when it scores at least
-/// `min_link` (and above 0) on two pieces of one blob. A joined blob takes the place of its
-/// first piece.
+/// object straddles a cut. `scores` are link scores of objects (rows) against `detections`,
+/// of which the `rows` listed are judged (objects with features); an object straddles a cut
+/// when it scores at least `min_link` (and above 0) on two pieces of one blob. A joined
+/// blob takes the place of its first piece.
 pub(super) fn join_straddled_cuts(
     detections: &[DetectedObject],
     scores: &LinkMatrix,
+    rows: &[usize],
     min_link: f64,
 ) -> Option<Vec<DetectedObject>> {
     let mut straddled: Vec<PixelBox> = Vec::new();
-    for i in 0..scores.rows() {
+    for &i in rows {
         let parts: Vec<PixelBox> = (0..scores.cols())
             .filter(|&j| scores.score(i, j) >= min_link && scores.score(i, j) > 0.0)
             .filter_map(|j| detections[j].cut_from)
@@ -97,7 +98,7 @@ mod tests {
         let mut apart = vec![at(42.0); 9];
         apart.push(at(55.5));
         let scores = LinkMatrix::new([&straddling[..], &apart[..]], &detections);
-        let joined = join_straddled_cuts(&detections, &scores, 0.2).unwrap();
+        let joined = join_straddled_cuts(&detections, &scores, &[0, 1], 0.2).unwrap();
         assert_eq!(joined.len(), 3);
         assert_eq!(joined[0].bbox, group);
         assert!(joined[0].cut_from.is_none());
@@ -105,7 +106,10 @@ mod tests {
         assert_eq!(joined[1..], detections[2..]);
         // One feature in ten across the cut is below the 0.2 link score: no straddle.
         let scores = LinkMatrix::new([&apart[..]], &detections);
-        assert!(join_straddled_cuts(&detections, &scores, 0.2).is_none());
+        assert!(join_straddled_cuts(&detections, &scores, &[0], 0.2).is_none());
+        // Rows not listed are not judged.
+        let scores = LinkMatrix::new([&straddling[..], &apart[..]], &detections);
+        assert!(join_straddled_cuts(&detections, &scores, &[1], 0.2).is_none());
     }
 
     #[test]

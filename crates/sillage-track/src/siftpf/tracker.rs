@@ -134,12 +134,17 @@ impl SiftPfTracker {
         check_sizes(&input)?;
         self.sift.analyse(input.grey)?;
         self.follow_features(&input);
-        let joined = self.join_straddled_cuts(input.detections);
+        let active = self.active_objects();
+        let mut scores = self.link_scores(&active, input.detections);
+        let joined = self.join_straddled_cuts(input.detections, &active, &scores);
+        if let Some(joined) = &joined {
+            scores = self.link_scores(&active, joined);
+        }
         let input = SiftPfFrame {
             detections: joined.as_deref().unwrap_or(input.detections),
             ..input
         };
-        let mut links = self.associate(&input);
+        let mut links = self.associate(&active, &scores);
         let mut free = self.apply_links(&input, &mut links);
         self.resume_occluded(&input, &mut free);
         self.start_objects(&input, &free);
@@ -171,12 +176,16 @@ impl SiftPfTracker {
             });
     }
 
-    /// The indices of the active objects and their link scores against `detections`
-    /// (Eq. 6); an object without features is scored by box overlap.
-    fn link_scores(&self, detections: &[DetectedObject]) -> (Vec<usize>, LinkMatrix) {
-        let active: Vec<usize> = (0..self.objects.len())
+    /// The indices of the active objects (tracked and intermediate).
+    fn active_objects(&self) -> Vec<usize> {
+        (0..self.objects.len())
             .filter(|&i| self.objects[i].is_active())
-            .collect();
+            .collect()
+    }
+
+    /// The link scores of the `active` objects (rows) against `detections` (Eq. 6); an
+    /// object without features is scored by box overlap.
+    fn link_scores(&self, active: &[usize], detections: &[DetectedObject]) -> LinkMatrix {
         let feature_lists: Vec<Vec<(Point2, f64)>> = active
             .iter()
             .map(|&i| scored_features(&self.objects[i]))
@@ -189,32 +198,39 @@ impl SiftPfTracker {
                 }
             }
         }
-        (active, scores)
+        scores
     }
 
     /// The detections with the cuts that an object's features straddle joined back
-    /// ([`super::cuts`]); `None` when every cut stands.
-    fn join_straddled_cuts(&self, detections: &[DetectedObject]) -> Option<Vec<DetectedObject>> {
+    /// ([`super::cuts`]), from the `scores` of the `active` objects against them; `None`
+    /// when every cut stands. Objects without features, scored by box overlap, say nothing
+    /// of a cut.
+    fn join_straddled_cuts(
+        &self,
+        detections: &[DetectedObject],
+        active: &[usize],
+        scores: &LinkMatrix,
+    ) -> Option<Vec<DetectedObject>> {
         if detections.iter().all(|d| d.cut_from.is_none()) {
             return None;
         }
-        let with_features: Vec<Vec<(Point2, f64)>> = self
-            .objects
-            .iter()
-            .filter(|o| o.is_active() && !o.features.is_empty())
-            .map(scored_features)
+        let with_features: Vec<usize> = (0..active.len())
+            .filter(|&row| !self.objects[active[row]].features.is_empty())
             .collect();
-        let scores = LinkMatrix::new(with_features.iter().map(Vec::as_slice), detections);
-        join_straddled_cuts(detections, &scores, self.params.association.min_link_score)
+        join_straddled_cuts(
+            detections,
+            scores,
+            &with_features,
+            self.params.association.min_link_score,
+        )
     }
 
-    /// §2.3: the link matrix of the active objects against the detections, and the case of
-    /// each active object (in the order of `self.objects`, occluded ones as `Link::None`).
-    fn associate(&self, input: &SiftPfFrame<'_>) -> Vec<Link> {
-        let (active, scores) = self.link_scores(input.detections);
+    /// §2.3: from the link `scores` of the `active` objects, the case of each active object
+    /// (in the order of `self.objects`, occluded ones as `Link::None`).
+    fn associate(&self, active: &[usize], scores: &LinkMatrix) -> Vec<Link> {
         let min_link = self.params.association.min_link_score;
         let targets = scores.targets(min_link);
-        let mut members = vec![0usize; input.detections.len()];
+        let mut members = vec![0usize; scores.cols()];
         for j in targets.iter().flatten() {
             members[*j] += 1;
         }
