@@ -90,7 +90,7 @@ pub(crate) fn group_components(
 }
 
 /// The pixels of `image` inside `bbox`.
-fn crop(image: &Image<bool>, bbox: &PixelBox) -> Image<bool> {
+pub(super) fn crop(image: &Image<bool>, bbox: &PixelBox) -> Image<bool> {
     let data = (bbox.y0..bbox.y1)
         .flat_map(|y| image.row(y)[bbox.x0..bbox.x1].iter().copied())
         .collect();

@@ -10,7 +10,7 @@
 use sillage_core::{Image, Point2};
 use sillage_image::PixelBox;
 
-use super::blobs::MotionBlob;
+use super::blobs::{MotionBlob, crop};
 
 /// When and how blobs are cut into people.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -123,14 +123,7 @@ fn piece(blob: &MotionBlob, x0: usize, x1: usize) -> Option<MotionBlob> {
         x1: hi.0 + 1,
         y1: hi.1 + 1,
     };
-    let mask = Image::from_vec(
-        local.width(),
-        local.height(),
-        (local.y0..local.y1)
-            .flat_map(|y| blob.mask.row(y)[local.x0..local.x1].iter().copied())
-            .collect(),
-    )
-    .unwrap_or_else(|_| unreachable!("a box inside the mask has its own size"));
+    let mask = crop(&blob.mask, &local);
     let (bx, by) = (blob.bbox.x0, blob.bbox.y0);
     Some(MotionBlob {
         bbox: PixelBox {
