@@ -186,3 +186,34 @@ fn large_uniform_set_matches_brute_force() {
         .collect();
     check_same(&points, &queries, 10);
 }
+
+#[test]
+fn batches_alternating_between_densities_match_brute_force() {
+    // Batch k-nearest queries guess each first block's candidates from the previous
+    // query's k-th distance: queries alternating between a dense and a sparse region make
+    // that guess far too tight or far too loose at every step.
+    let scatter = |i: u64, w: f64, x0: f64| {
+        let h = i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        Point2::new(
+            x0 + (h >> 40) as f64 / (1u64 << 24) as f64 * w,
+            ((h >> 16) & 0xFF_FFFF) as f64 / (1u64 << 24) as f64 * 100.0,
+        )
+    };
+    let points: Vec<Point2> = (0..3000u64)
+        .map(|i| scatter(i, 100.0, 0.0))
+        .chain((3000..4000u64).map(|i| scatter(i, 900.0, 100.0)))
+        .collect();
+    let queries: Vec<Point2> = (0..600u64)
+        .map(|i| {
+            let p = scatter(i * 31 + 7, 100.0, 0.0);
+            if i % 2 == 0 {
+                p
+            } else {
+                Point2::new(p.x * 9.0 + 100.0, p.y)
+            }
+        })
+        .collect();
+    for k in [1, 4, 10, 25] {
+        check_same(&points, &queries, k);
+    }
+}
