@@ -436,7 +436,7 @@ impl PointIndex {
         counts: M,
         d2: &mut [f64],
         keys: &mut [u64],
-        block: &mut BlockCandidates,
+        block: Option<&mut BlockCandidates>,
     ) -> (usize, usize) {
         let mut best = KBest {
             px: p.x,
@@ -453,8 +453,8 @@ impl PointIndex {
         };
         if k > 0 {
             self.search(p, &mut best);
-            if best.samples >= k {
-                best.block.last_worst = best.worst;
+            if let Some(block) = best.block.as_deref_mut().filter(|_| best.samples >= k) {
+                block.last_worst = best.worst;
             }
         }
         (best.n, best.samples)
@@ -570,7 +570,8 @@ impl PointIndex {
                     let (mut ids, mut slots) = (vec![0; k + 1], vec![0; k + 1]);
                     let mut block = BlockCandidates::new();
                     for (&q, o) in queries.iter().zip(out) {
-                        let (n, samples) = self.k_nearest_into(q, k, counts, d2, keys, &mut block);
+                        let (n, samples) =
+                            self.k_nearest_into(q, k, counts, d2, keys, Some(&mut block));
                         for ((&key, id), slot) in keys[..n].iter().zip(&mut ids).zip(&mut slots) {
                             (*id, *slot) = split_key(key);
                         }
@@ -774,8 +775,9 @@ impl Multiplicity for BySlot<'_> {
 struct KBest<'a, M> {
     px: f64,
     py: f64,
-    /// Scratch for the first block, carried from query to query.
-    block: &'a mut BlockCandidates,
+    /// Scratch for the first block, carried from query to query (batches only: a single
+    /// query has no previous one to guess from).
+    block: Option<&'a mut BlockCandidates>,
     k: usize,
     /// Points held, and the samples they stand for.
     n: usize,
@@ -878,10 +880,12 @@ impl<M: Multiplicity> KBest<'_, M> {
     #[inline]
     fn select_block(&mut self, index: &PointIndex, runs: &[Range<usize>]) -> bool {
         let total: usize = runs.iter().map(|r| r.len()).sum();
-        if self.n > 0 || total > BLOCK_CAP || !self.block.last_worst.is_finite() {
+        let Some(block) = self.block.as_deref_mut() else {
+            return false;
+        };
+        if self.n > 0 || total > BLOCK_CAP || !block.last_worst.is_finite() {
             return false;
         }
-        let block = &mut *self.block;
         let counts = self.counts;
         let mut t = 0;
         for run in runs {
@@ -987,7 +991,7 @@ impl NeighbourIndex for PointIndex {
         out.clear();
         let k = k.min(self.xs.len());
         with_scratch(k + 1, |d2, ids| {
-            let (n, _) = self.k_nearest_into(p, k, Single, d2, ids, &mut BlockCandidates::new());
+            let (n, _) = self.k_nearest_into(p, k, Single, d2, ids, None);
             out.extend(
                 ids[..n]
                     .iter()
