@@ -496,7 +496,7 @@ impl PedestrianTracker {
                         .expect("validated σ"),
                     mode: 0,
                 };
-                let (track_id, age) = match self.revive(frame, &person) {
+                let (track_id, age) = match self.revive(frame, &person, cues.is_some()) {
                     Some(track_id) => (track_id, self.params.confirm_frames),
                     None => {
                         self.next_id += 1;
@@ -524,24 +524,43 @@ impl PedestrianTracker {
 impl PedestrianTracker {
     /// The identity of the departed tracker whose extrapolated (or last) foot point is
     /// nearest to `person`'s, within half its height; removed from the departed.
-    fn revive(&mut self, frame: FrameIndex, person: &PersonBox) -> Option<TrackId> {
+    /// `on_images`: the trackers are weighed on frames (not detections alone).
+    fn revive(
+        &mut self,
+        frame: FrameIndex,
+        person: &PersonBox,
+        on_images: bool,
+    ) -> Option<TrackId> {
         let foot = person.foot();
         let gate = 0.5 * person.height_px;
         let (k, _) = self
             .departed
             .iter()
             .enumerate()
-            .map(|(k, d)| {
-                let elapsed = (frame - d.frame) as f64;
-                let predicted = d.foot + d.vel_px_per_frame * elapsed;
-                // The velocity of a tracker that was losing its person may be wrong: the
-                // last foot point counts as well.
-                (k, (predicted - foot).norm().min((d.foot - foot).norm()))
-            })
+            .map(|(k, d)| (k, revival_distance(d, frame, foot, on_images)))
             .filter(|&(_, distance)| distance <= gate)
             .min_by(|a, b| a.1.total_cmp(&b.1))?;
         Some(self.departed.swap_remove(k).track_id)
     }
+}
+
+/// How far `foot` lies, at `frame`, from where the departed tracker `d` would be: the
+/// nearest of its foot point when it died and, on images (`on_images`), its last reported
+/// one, each as it stood and extrapolated by its velocity. On images the estimate of the
+/// frame it died in comes from a weighting that failed and may have jumped off its path; on
+/// detections alone it is a coasting prediction like those before it. The velocity of a
+/// tracker that was losing its person may be wrong, hence the unextrapolated points too.
+fn revival_distance(d: &Departed, frame: FrameIndex, foot: Point2, on_images: bool) -> f64 {
+    let reported = d.recent_feet.last().copied().filter(|_| on_images);
+    [(d.frame, d.foot)]
+        .into_iter()
+        .chain(reported)
+        .flat_map(|(then, at)| {
+            let elapsed = (frame - then) as f64;
+            [at, at + d.vel_px_per_frame * elapsed]
+        })
+        .map(|at| (at - foot).norm())
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The index of the unconfirmed tracker of `tracks` (younger than `confirm` frames) that
@@ -639,5 +658,32 @@ mod tests {
         assert_eq!(pick(&[(3, 12, 134.0, 70.0), (5, 13, 110.0, 70.0)]), Some(5));
         // Born before the path's frames kept: no comparison, no heir.
         assert_eq!(pick(&[(3, 8, 100.0, 70.0)]), None);
+    }
+
+    #[test]
+    fn revival_looks_from_the_last_reported_foot_on_images_only() {
+        // Reported at x = 700 in frame 121 while walking left 5 px a frame; in frame 122,
+        // the one it died in, its estimate jumped back to x = 730.
+        let departed = Departed {
+            track_id: 12,
+            foot: Point2::new(730.0, 300.0),
+            vel_px_per_frame: Vec2::new(-5.0, 0.0),
+            frame: 122,
+            recent_feet: vec![
+                (120, Point2::new(706.0, 300.0)),
+                (121, Point2::new(700.0, 300.0)),
+            ],
+        };
+        // A birth at x = 680 in frame 123: 10 px from the reported foot extrapolated by two
+        // frames (690), 45 px from the dying estimate extrapolated by one (725).
+        let born = Point2::new(680.0, 300.0);
+        assert_eq!(revival_distance(&departed, 123, born, true), 10.0);
+        assert_eq!(revival_distance(&departed, 123, born, false), 45.0);
+        // Without any reported foot, the dying estimate alone.
+        let alone = Departed {
+            recent_feet: Vec::new(),
+            ..departed
+        };
+        assert_eq!(revival_distance(&alone, 123, born, true), 45.0);
     }
 }
