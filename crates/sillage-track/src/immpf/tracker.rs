@@ -523,8 +523,8 @@ impl PedestrianTracker {
 
 impl PedestrianTracker {
     /// The identity of the departed tracker whose extrapolated (or last) foot point is
-    /// nearest to `person`'s, within half its height; removed from the departed.
-    /// `on_images`: the trackers are weighed on frames (not detections alone).
+    /// nearest to `person`'s, relative to its gate ([`revival_gate`]); removed from the
+    /// departed. `on_images`: the trackers are weighed on frames (not detections alone).
     fn revive(
         &mut self,
         frame: FrameIndex,
@@ -532,16 +532,34 @@ impl PedestrianTracker {
         on_images: bool,
     ) -> Option<TrackId> {
         let foot = person.foot();
-        let gate = 0.5 * person.height_px;
         let (k, _) = self
             .departed
             .iter()
             .enumerate()
-            .map(|(k, d)| (k, revival_distance(d, frame, foot, on_images)))
-            .filter(|&(_, distance)| distance <= gate)
+            .map(|(k, d)| {
+                let gate = revival_gate(&self.params, frame - d.frame, on_images);
+                let distance = revival_distance(d, frame, foot, on_images);
+                (k, distance / (gate * person.height_px))
+            })
+            .filter(|&(_, relative)| relative <= 1.0)
             .min_by(|a, b| a.1.total_cmp(&b.1))?;
         Some(self.departed.swap_remove(k).track_id)
     }
+}
+
+/// The radius, in box heights, within which a person born `elapsed` frames after a tracker's
+/// death takes its identity back: half a height, widened on images by
+/// `revive_gate_growth` per frame up to `revive_gate_max`. The dying tracker's velocity is
+/// least reliable when it lost its person (it lagged behind a walker who went behind
+/// others), so the farther the person may have walked since, the wider the gate. On
+/// detections alone it stays at half a height: a tracker there has already coasted on its
+/// prediction for `unsupported_frames` frames before it died (docs/immpf.md).
+fn revival_gate(params: &PedestrianParams, elapsed: FrameIndex, on_images: bool) -> f64 {
+    const BASE: f64 = 0.5;
+    if !on_images {
+        return BASE;
+    }
+    (BASE + params.revive_gate_growth * elapsed as f64).min(params.revive_gate_max)
 }
 
 /// How far `foot` lies, at `frame`, from where the departed tracker `d` would be: the
@@ -685,5 +703,21 @@ mod tests {
             ..departed
         };
         assert_eq!(revival_distance(&alone, 123, born, true), 45.0);
+    }
+
+    #[test]
+    fn the_revival_gate_widens_with_time_on_images_only() {
+        let params = PedestrianParams::default();
+        // Half a height at the death; a walker's pace (0.1 height a frame) after it, up to
+        // 1.5 heights; half a height throughout on detections alone.
+        assert_eq!(revival_gate(&params, 0, true), 0.5);
+        assert!((revival_gate(&params, 5, true) - 1.0).abs() < 1e-12);
+        assert_eq!(revival_gate(&params, 20, true), 1.5);
+        assert_eq!(revival_gate(&params, 5, false), 0.5);
+        let still = PedestrianParams {
+            revive_gate_growth: 0.0,
+            ..params
+        };
+        assert_eq!(revival_gate(&still, 20, true), 0.5);
     }
 }
