@@ -14,7 +14,7 @@ use sillage_filter::{
 
 use super::appearance::{Appearance, FrameCues, HistogramScratch};
 use super::models::PedestrianMotion;
-use super::params::{ModelName, PedestrianParams};
+use super::params::{ModelName, PedestrianParams, REVIVAL_GATE_AT_DEATH};
 use super::person_box::PersonBox;
 use super::sizing::BoxSizing;
 
@@ -555,11 +555,10 @@ impl PedestrianTracker {
 /// detections alone it stays at half a height: a tracker there has already coasted on its
 /// prediction for `unsupported_frames` frames before it died (docs/immpf.md).
 fn revival_gate(params: &PedestrianParams, elapsed: FrameIndex, on_images: bool) -> f64 {
-    const BASE: f64 = 0.5;
     if !on_images {
-        return BASE;
+        return REVIVAL_GATE_AT_DEATH;
     }
-    (BASE + params.revive_gate_growth * elapsed as f64).min(params.revive_gate_max)
+    (REVIVAL_GATE_AT_DEATH + params.revive_gate_growth * elapsed as f64).min(params.revive_gate_max)
 }
 
 /// How far `foot` lies, at `frame`, from where the departed tracker `d` would be: the
