@@ -1,0 +1,157 @@
+//! The outputs of the four trackers on fixed inputs, pinned by a hash of their rows: a
+//! refactoring that moves code between crates must leave every row bit-identical. The
+//! header comments of track files (the parameters they were made with) are left out of the
+//! hash, so documenting a parameter differently does not count as a change of results.
+//!
+//! When a change is meant to alter results, the failure prints the new hash: update the
+//! table and say why in the commit.
+
+mod common;
+
+use std::fs;
+use std::path::Path;
+
+use common::{path_str, run_ok};
+
+const SHARED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
+
+/// FNV-1a over the file's lines that are not comments (`#`, `%`), each ended by `\n`.
+fn rows_hash(path: &Path) -> u64 {
+    let text = fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    for line in text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with('%'))
+    {
+        for byte in line.bytes().chain(std::iter::once(b'\n')) {
+            hash ^= u64::from(byte);
+            hash = hash.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    hash
+}
+
+fn assert_rows(path: &Path, expected: u64, what: &str) {
+    let rows = fs::read_to_string(path).unwrap().lines().count();
+    assert!(rows > 10, "{what}: only {rows} lines in {}", path.display());
+    let got = rows_hash(path);
+    assert_eq!(got, expected, "{what}: rows changed, hash now {got:#018x}");
+}
+
+#[test]
+fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = dir.path().join("vortex");
+    run_ok(&[
+        "synth",
+        "vortex",
+        "--out",
+        path_str(&frames),
+        "--frames",
+        "12",
+        "--particles",
+        "800",
+        "--width",
+        "512",
+        "--height",
+        "512",
+    ]);
+    let expected = [
+        ("tracks_track.txt", 0x7f46_a60e_27e4_e4e0_u64),
+        ("tracks.csv", 0xf855_b2fc_7a31_e028),
+    ];
+    for (name, hash) in expected {
+        let out = dir.path().join(name);
+        run_ok(&["ptv", path_str(&frames), "--out", path_str(&out)]);
+        assert_rows(&out, hash, name);
+    }
+}
+
+#[test]
+fn bedload_rows_of_the_real_frames_are_unchanged() {
+    let data = format!("{SHARED}/bedload_beads_lafaye2018");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tracks.csv");
+    run_ok(&[
+        "track",
+        "bedload",
+        &format!("{data}/images"),
+        "--sequence-params",
+        &format!("{data}/sequence_param.txt"),
+        "--mask",
+        &format!("{data}/sequence_base_mask.tif"),
+        "--out",
+        path_str(&out),
+    ]);
+    assert_rows(&out, 0xe7a3_6120_a755_ec05, "track bedload");
+}
+
+/// The ground plane of PETS 2009 S2.L1, fitted from its truth.
+fn pets_ground_plane(dir: &Path) -> String {
+    let out = dir.join("ground.toml");
+    run_ok(&[
+        "fit",
+        "homography",
+        &format!("{SHARED}/pets09_s2l1/gt/gt.txt"),
+        "--out",
+        path_str(&out),
+    ]);
+    path_str(&out).to_string()
+}
+
+#[test]
+fn immpf_rows_on_pets_frames_are_unchanged_for_seeds_1_to_3() {
+    let dir = tempfile::tempdir().unwrap();
+    let ground = pets_ground_plane(dir.path());
+    let expected = [
+        (1, 0x3290_3a7c_8ed0_7a37_u64),
+        (2, 0x1d4d_0563_c0f8_8160),
+        (3, 0xb862_097d_5f91_ae84),
+    ];
+    for (seed, hash) in expected {
+        let out = dir.path().join(format!("immpf_{seed}.txt"));
+        let weights = dir.path().join(format!("weights_{seed}.csv"));
+        run_ok(&[
+            "track",
+            "immpf",
+            &format!("{SHARED}/pets09_s2l1/img1"),
+            "--ground-plane",
+            &ground,
+            "--models",
+            "CV_CA",
+            "--seed",
+            &seed.to_string(),
+            "--model-weights",
+            path_str(&weights),
+            "--out",
+            path_str(&out),
+        ]);
+        assert_rows(&out, hash, &format!("track immpf, seed {seed}"));
+        assert!(fs::read_to_string(&weights).unwrap().lines().count() > 10);
+    }
+}
+
+#[test]
+fn siftpf_rows_on_pets_frames_are_unchanged_for_seeds_1_to_3() {
+    let dir = tempfile::tempdir().unwrap();
+    let expected = [
+        (1, 0x6f08_896f_5fed_1fb0_u64),
+        (2, 0xee61_e484_d185_e29a),
+        (3, 0x519d_780d_fa8f_eda0),
+    ];
+    for (seed, hash) in expected {
+        let out = dir.path().join(format!("siftpf_{seed}.txt"));
+        run_ok(&[
+            "track",
+            "siftpf",
+            &format!("{SHARED}/pets09_s2l1/img1"),
+            "--seed",
+            &seed.to_string(),
+            "--max-frames",
+            "60",
+            "--out",
+            path_str(&out),
+        ]);
+        assert_rows(&out, hash, &format!("track siftpf, seed {seed}"));
+    }
+}
