@@ -4,9 +4,10 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use sillage::core::BoundingBox;
 use sillage::core::FrameIndex;
 use sillage::eval::MotData;
-use sillage::eval::mot::{BoundingBox, MotChallengeProtocol, MotEstimate, MotTruth, Shape};
+use sillage::eval::mot::{MotChallengeProtocol, MotEstimate, MotTruth, Shape};
 
 use crate::cli::MatchRule;
 use crate::eval_inputs::load_truth;

@@ -10,7 +10,8 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use sillage::eval::mot::{BoundingBox, MotMetrics, MotParams, clear_events, evaluate_mot};
+use sillage::core::BoundingBox;
+use sillage::eval::mot::{MotMetrics, MotParams, clear_events, evaluate_mot};
 use sillage::eval::papers::{EtiseoMetrics, etiseo};
 use sillage::track::siftpf::FeatureSelection;
 

@@ -6,10 +6,8 @@ use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
-use sillage::core::{FrameIndex, Point2};
-use sillage::eval::mot::{
-    BoundingBox, MotChallengeProtocol, MotEstimate, MotTruth, Shape, TruthRole,
-};
+use sillage::core::{BoundingBox, FrameIndex, Point2};
+use sillage::eval::mot::{MotChallengeProtocol, MotEstimate, MotTruth, Shape, TruthRole};
 use sillage::eval::papers::StateLabel;
 use sillage::io::{
     BEAD_HEADER, BeadPoint, BeadSequenceParams, MotFileRole, MotRow, TRACK_COLUMNS, TRUTH_HEADER,

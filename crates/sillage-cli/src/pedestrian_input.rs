@@ -6,11 +6,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
+use sillage::core::BoundingBox;
 use sillage::core::{FrameIndex, GrayImage, RgbImage};
 use sillage::detect::motion::{MotionBlob, MotionDetector, MotionParams};
 use sillage::io::read_mot_rows;
 use sillage::io::{FrameOptions, FrameSource, open_frames};
-use sillage::track::immpf::{AppearanceParams, Candidate, FrameCues, PersonBox};
+use sillage::track::immpf::{AppearanceParams, Candidate, FrameCues};
 
 /// One frame ready for the tracker.
 pub struct PreparedFrame {
@@ -56,7 +57,7 @@ pub fn read_candidates(path: &Path) -> Result<BTreeMap<FrameIndex, Vec<Candidate
     let mut frames: BTreeMap<FrameIndex, Vec<Candidate>> = BTreeMap::new();
     for row in rows {
         frames.entry(row.frame).or_default().push(Candidate {
-            bbox: PersonBox {
+            bbox: BoundingBox {
                 left_px: row.left_px,
                 top_px: row.top_px,
                 width_px: row.width_px,
@@ -224,7 +225,7 @@ impl PedestrianInput {
 /// A motion blob as a birth candidate (score 1).
 fn blob_candidate(blob: &MotionBlob) -> Candidate {
     Candidate {
-        bbox: PersonBox {
+        bbox: BoundingBox {
             left_px: blob.bbox.x0 as f64,
             top_px: blob.bbox.y0 as f64,
             width_px: blob.bbox.width() as f64,

@@ -20,6 +20,7 @@
 //! assert_eq!(detection.pos_px.y, 2.0);
 //! ```
 
+mod bbox;
 mod calibration;
 mod error;
 mod geometry;
@@ -29,6 +30,7 @@ mod observation;
 mod rng;
 mod roles;
 
+pub use bbox::BoundingBox;
 pub use calibration::Calibration;
 pub use error::{Error, Result};
 pub use geometry::{Point2, Vec2};

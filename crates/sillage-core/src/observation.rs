@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Point2, Vec2};
+use crate::{BoundingBox, Point2, Vec2};
 
 /// 0-based index of a frame in its sequence.
 pub type FrameIndex = u64;
@@ -142,6 +142,10 @@ pub struct TrackPoint {
     /// back to its detection's other attributes without matching coordinates.
     #[serde(default)]
     pub detection: Option<u32>,
+    /// The object's box, px, for trackers that follow boxes (pedestrians): `pos_px` is then
+    /// the point the tracker follows in it (the IMM-PF's foot point, the SIFT-PF's centre).
+    #[serde(default)]
+    pub bbox: Option<BoundingBox>,
 }
 
 impl TrackPoint {
@@ -159,6 +163,7 @@ impl TrackPoint {
             class: 0,
             spread_px: None,
             detection: None,
+            bbox: None,
         }
     }
 }

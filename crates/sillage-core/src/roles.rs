@@ -1,11 +1,17 @@
 //! The role traits the pipeline is built from.
 
-use crate::{Detection, FrameIndex, GrayImage, Result, TrackPoint};
+use crate::{BoundingBox, Detection, FrameIndex, GrayImage, Result, TrackPoint};
 
 /// Finds objects in one pre-processed frame.
 pub trait Detector {
     /// Appends the detections of `image` to `out` (cleared first), reusing its allocation.
     fn detect(&mut self, image: &GrayImage, out: &mut Vec<Detection>) -> Result<()>;
+
+    /// The box of each detection of the last [`Detector::detect`], in the same order, for
+    /// detectors of extended objects (motion blobs); empty for detectors of points.
+    fn boxes(&self) -> &[BoundingBox] {
+        &[]
+    }
 }
 
 /// Everything a tracker may look at for one frame.

@@ -4,9 +4,10 @@
 //! one large sparse component.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use sillage_core::BoundingBox;
 use sillage_eval::mot::{
-    BoundingBox, MotChallengeProtocol, MotData, MotEstimate, MotParams, MotTruth, Shape,
-    Similarity, TruthRole, evaluate_mot,
+    MotChallengeProtocol, MotData, MotEstimate, MotParams, MotTruth, Shape, Similarity, TruthRole,
+    evaluate_mot,
 };
 use sillage_io::{MotRow, read_mot_rows};
 

@@ -1,10 +1,11 @@
 //! CLEAR MOT and Identity on hand-made sequences: where TrackEval and py-motmetrics differ,
 //! the optimal identity assignment, MOTChallenge preprocessing, and input errors.
 
+use sillage_core::BoundingBox;
 use sillage_core::Point2;
 use sillage_eval::mot::{
-    BoundingBox, FrameSimilarities, MotChallengeProtocol, MotConvention, MotData, MotEstimate,
-    MotParams, MotTruth, Shape, Similarity, TruthRole, clear_events, clear_mot, identity,
+    FrameSimilarities, MotChallengeProtocol, MotConvention, MotData, MotEstimate, MotParams,
+    MotTruth, Shape, Similarity, TruthRole, clear_events, clear_mot, identity,
 };
 
 /// Points compared by distance: similarity 1 − d / 2, so 0.5 ↔ d = 1 px.

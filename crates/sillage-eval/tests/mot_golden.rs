@@ -2,10 +2,11 @@
 //! on the TUD-Campus and TUD-Stadtmitte files shipped with py-motmetrics 1.4.0
 //! (`../shared/data/motmetrics_tud_reference/README.md`), every value to 1e-6.
 
+use sillage_core::BoundingBox;
 use sillage_eval::mot::{
-    BoundingBox, ClearMetrics, HotaMetrics, IdentityMetrics, MotChallengeProtocol, MotConvention,
-    MotData, MotEstimate, MotMetrics, MotParams, MotReport, MotTruth, Shape, Similarity,
-    clear_events, evaluate_mot,
+    ClearMetrics, HotaMetrics, IdentityMetrics, MotChallengeProtocol, MotConvention, MotData,
+    MotEstimate, MotMetrics, MotParams, MotReport, MotTruth, Shape, Similarity, clear_events,
+    evaluate_mot,
 };
 use sillage_io::{MotRow, read_mot_rows};
 

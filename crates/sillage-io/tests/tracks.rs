@@ -310,6 +310,8 @@ fn formats_from_paths_and_names() {
     assert!(TrackFormat::from_path(Path::new("a.xlsx")).is_err());
     for format in TrackFormat::ALL {
         assert_eq!(format.to_string().parse::<TrackFormat>().unwrap(), format);
+        let named = format!("x.{}", format.extension());
+        assert_eq!(TrackFormat::from_path(Path::new(&named)).unwrap(), format);
     }
     let err = "xml".parse::<TrackFormat>().unwrap_err().to_string();
     assert!(err.contains("`format` = xml"), "{err}");

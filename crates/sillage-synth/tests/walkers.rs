@@ -2,8 +2,9 @@
 //! through the motion detector the SIFT-PF tracker starts from
 //! (`sillage_detect::motion::MotionDetector`, default parameters).
 
+use sillage_core::BoundingBox;
 use sillage_detect::motion::{MotionBlob, MotionDetector, MotionParams};
-use sillage_eval::mot::{BoundingBox, box_iou};
+use sillage_eval::mot::box_iou;
 use sillage_synth::{
     CrossingParams, GroupSplitParams, RandomParams, Scenario, WalkerTruth, WalkersFrame,
     WalkersParams, WalkersSequence,

@@ -2,10 +2,10 @@
 //! grey ground, seen through the colour / motion / foreground likelihood, and detections
 //! alone.
 
-use sillage_core::{GrayImage, Image, RgbImage};
+use sillage_core::{BoundingBox, GrayImage, Image, RgbImage};
 use sillage_track::immpf::{
     AppearanceParams, BoxSizing, Candidate, FrameCues, ModelName, PedestrianEstimate,
-    PedestrianFrame, PedestrianParams, PedestrianTracker, PersonBox,
+    PedestrianFrame, PedestrianParams, PedestrianTracker,
 };
 
 const W: usize = 320;
@@ -22,11 +22,11 @@ const WALKERS: [Walker; 2] = [
 
 /// Walker `k`'s box at `frame`; from frame `turn_at` on, the walkers walk back the way they
 /// came.
-fn truth(frame: usize, k: usize, turn_at: usize) -> PersonBox {
+fn truth(frame: usize, k: usize, turn_at: usize) -> BoundingBox {
     let (x, y, v, _, _) = WALKERS[k];
     let out = frame.min(turn_at) as f64;
     let back = frame.saturating_sub(turn_at) as f64;
-    PersonBox::standing_on(
+    BoundingBox::standing_on(
         sillage_core::Point2::new(x + v * (out - back), y),
         16.0,
         48.0,
@@ -44,7 +44,7 @@ fn render(frame: usize, turn_at: usize) -> (RgbImage, GrayImage, Image<bool>) {
 }
 
 /// A person's box, top colour and bottom colour.
-type Person = (PersonBox, [u8; 3], [u8; 3]);
+type Person = (BoundingBox, [u8; 3], [u8; 3]);
 
 /// The colour image, grey levels and foreground mask of `people` on a textured grey ground,
 /// hidden where they stand behind `wall` (its left and right x, px; the full height).
@@ -384,7 +384,7 @@ fn a_tracker_lost_as_a_duplicate_at_a_crossing_gives_its_identity_back() {
         for frame in 0..60u64 {
             let f = frame as f64;
             let candidates = [60.0 + 3.0 * f, 240.0 - 3.0 * f].map(|x| Candidate {
-                bbox: PersonBox::standing_on(sillage_core::Point2::new(x, 150.0), 16.0, 48.0),
+                bbox: BoundingBox::standing_on(sillage_core::Point2::new(x, 150.0), 16.0, 48.0),
                 score: 1.0,
             });
             let observations = PedestrianFrame {
@@ -430,7 +430,7 @@ fn a_walker_who_speeds_up_behind_a_wall_keeps_its_identity() {
         let mut previous: Option<GrayImage> = None;
         let mut out = Vec::new();
         for frame in 0..80 {
-            let b = PersonBox::standing_on(
+            let b = BoundingBox::standing_on(
                 sillage_core::Point2::new(foot_x(frame), 150.0),
                 16.0,
                 HEIGHT,

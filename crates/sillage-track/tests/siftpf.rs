@@ -5,13 +5,13 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use sillage_core::BoundingBox;
 use sillage_core::{FrameIndex, Image};
 use sillage_detect::motion::{MotionDetector, MotionParams};
 use sillage_synth::{
     CrossingParams, GroupSplitParams, Scenario, WalkerTruth, WalkersFrame, WalkersParams,
     WalkersSequence,
 };
-use sillage_track::immpf::PersonBox;
 use sillage_track::siftpf::{
     DetectedObject, SiftPfEstimate, SiftPfFrame, SiftPfParams, SiftPfTracker,
 };
@@ -48,9 +48,9 @@ fn track(frames: &[WalkersFrame], seed: u64) -> Vec<SiftPfEstimate> {
     out
 }
 
-fn truth_box(t: &WalkerTruth) -> PersonBox {
+fn truth_box(t: &WalkerTruth) -> BoundingBox {
     // Truth pixel k spans [k − 0.5, k + 0.5]; the tracker's boxes start at the first pixel.
-    PersonBox {
+    BoundingBox {
         left_px: t.left_px + 0.5,
         top_px: t.top_px + 0.5,
         width_px: t.width_px,

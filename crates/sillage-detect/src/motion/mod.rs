@@ -10,7 +10,7 @@ mod mixture;
 mod split;
 
 use serde::{Deserialize, Serialize};
-use sillage_core::{Error, GrayImage, Image, Result};
+use sillage_core::{BoundingBox, Detection, Detector, Error, GrayImage, Image, Result};
 use sillage_image::{Component, ComponentLabeller, Morphology, StructuringElement};
 
 pub use blobs::MotionBlob;
@@ -121,6 +121,9 @@ pub struct MotionDetector {
     cleaned: GrayImage,
     foreground: Image<bool>,
     components: Vec<Component>,
+    /// The last frame's blobs and their boxes, for the [`Detector`] role.
+    blobs: Vec<MotionBlob>,
+    boxes: Vec<BoundingBox>,
 }
 
 impl MotionDetector {
@@ -144,6 +147,8 @@ impl MotionDetector {
             cleaned: GrayImage::new(width, height),
             foreground: Image::new(width, height),
             components: Vec::new(),
+            blobs: Vec::new(),
+            boxes: Vec::new(),
         })
     }
 
@@ -172,6 +177,11 @@ impl MotionDetector {
         }
         .apply(out);
         Ok(())
+    }
+
+    /// The blobs of the last [`Detector::detect`] call (its detections, with their masks).
+    pub fn blobs(&self) -> &[MotionBlob] {
+        &self.blobs
     }
 
     /// The last frame's labels from the background model ([`BACKGROUND`], [`SHADOW`],
@@ -214,5 +224,39 @@ impl MotionDetector {
         {
             *f = b > 0.5;
         }
+    }
+}
+
+/// The box of a blob, px (its pixel box's left/top corner and size).
+pub fn blob_box(blob: &MotionBlob) -> BoundingBox {
+    BoundingBox {
+        left_px: blob.bbox.x0 as f64,
+        top_px: blob.bbox.y0 as f64,
+        width_px: blob.bbox.width() as f64,
+        height_px: blob.bbox.height() as f64,
+    }
+}
+
+/// Motion blobs as detections: each at the centroid of its moving pixels, its area (px²) as
+/// strength, its box in [`Detector::boxes`], the blob itself in [`MotionDetector::blobs`].
+impl Detector for MotionDetector {
+    fn detect(&mut self, image: &GrayImage, out: &mut Vec<Detection>) -> Result<()> {
+        let mut blobs = std::mem::take(&mut self.blobs);
+        let found = MotionDetector::detect(self, image, &mut blobs);
+        self.blobs = blobs;
+        found?;
+        out.clear();
+        out.extend(
+            self.blobs
+                .iter()
+                .map(|b| Detection::new(b.centroid, b.area as f32)),
+        );
+        self.boxes.clear();
+        self.boxes.extend(self.blobs.iter().map(blob_box));
+        Ok(())
+    }
+
+    fn boxes(&self) -> &[BoundingBox] {
+        &self.boxes
     }
 }

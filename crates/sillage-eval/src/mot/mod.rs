@@ -52,7 +52,7 @@ pub use data::{
 pub use hota::{HOTA_ALPHA_COUNT, HotaCurves, HotaMetrics, PerAlpha, hota, hota_alphas};
 pub use identity::{IdentityMetrics, identity};
 pub use params::{MotConvention, MotParams};
-pub use similarity::{BoundingBox, Shape, Similarity, box_iou, disc_iou, distance_similarity};
+pub use similarity::{Shape, Similarity, box_iou, disc_iou, distance_similarity};
 
 /// CLEAR MOT, Identity and HOTA of one sequence (or of several combined).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

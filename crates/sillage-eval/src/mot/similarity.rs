@@ -3,32 +3,7 @@
 //! similarity (`_calculate_euclidean_similarity`), and the IoU of two discs for beads.
 
 use serde::{Deserialize, Serialize};
-use sillage_core::{Error, Point2, Result};
-
-/// An axis-aligned box: its left/top corner, width and height, px.
-///
-/// MOTChallenge's `bb_left, bb_top, bb_width, bb_height`, kept as written in the file.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct BoundingBox {
-    /// Left edge, px.
-    pub left_px: f64,
-    /// Top edge, px.
-    pub top_px: f64,
-    /// Width, px (≥ 0).
-    pub width_px: f64,
-    /// Height, px (≥ 0).
-    pub height_px: f64,
-}
-
-impl BoundingBox {
-    /// The box's centre.
-    pub fn centre(&self) -> Point2 {
-        Point2::new(
-            self.left_px + self.width_px / 2.0,
-            self.top_px + self.height_px / 2.0,
-        )
-    }
-}
+use sillage_core::{BoundingBox, Error, Point2, Result};
 
 /// The geometry of one object in one frame.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -2,7 +2,8 @@
 //! non-overlapping slots, replaced by new objects as they end, and a tracker's output with
 //! misses, noise, identity switches and false positives.
 
-use sillage_eval::mot::{BoundingBox, MotEstimate, MotTruth, Shape, TruthRole};
+use sillage_core::BoundingBox;
+use sillage_eval::mot::{MotEstimate, MotTruth, Shape, TruthRole};
 
 /// What to generate.
 #[derive(Debug, Clone, Copy)]

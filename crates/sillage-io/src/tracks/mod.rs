@@ -66,6 +66,16 @@ impl TrackFormat {
             Self::Hdf5 => "hdf5",
         }
     }
+
+    /// The file extension [`TrackFormat::from_path`] reads as this format.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Tractrac => "txt",
+            Self::Csv => "csv",
+            Self::Parquet => "parquet",
+            Self::Hdf5 => "h5",
+        }
+    }
 }
 
 impl fmt::Display for TrackFormat {

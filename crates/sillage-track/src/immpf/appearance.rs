@@ -12,7 +12,7 @@ use sillage_core::{Error, GrayImage, Image, Result, RgbImage};
 use sillage_image::{BinImage, BoxPx, HsvBinning, bhattacharyya_coefficient};
 
 use super::foreground::ForegroundShare;
-use super::person_box::PersonBox;
+use sillage_core::BoundingBox;
 
 /// Parameters of the colour and motion likelihood.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -166,7 +166,7 @@ impl FrameCues {
 
     /// The share of `b`'s pixels that the foreground mask marks; `None` without a mask or
     /// when `b` holds no pixel.
-    pub(crate) fn foreground_share(&self, b: &PersonBox) -> Option<f64> {
+    pub(crate) fn foreground_share(&self, b: &BoundingBox) -> Option<f64> {
         if self.has_foreground {
             self.foreground.share(b)
         } else {
@@ -201,9 +201,9 @@ impl Appearance {
     pub fn capture(
         params: &AppearanceParams,
         cues: &FrameCues,
-        person: &PersonBox,
+        person: &BoundingBox,
     ) -> Option<Self> {
-        let histogram = |bins: &BinImage, b: PersonBox| {
+        let histogram = |bins: &BinImage, b: BoundingBox| {
             let mut h = vec![0.0; bins.bins()];
             (box_histogram(bins, &b, params.stride, &mut h) > 0).then_some(h)
         };
@@ -232,7 +232,7 @@ impl Appearance {
         &self,
         params: &AppearanceParams,
         cues: &FrameCues,
-        person: &PersonBox,
+        person: &BoundingBox,
         scratch: &mut HistogramScratch,
     ) -> Option<f64> {
         let (top, bottom) = (&mut scratch.top, &mut scratch.bottom_or_motion);
@@ -256,7 +256,7 @@ impl Appearance {
         &mut self,
         params: &AppearanceParams,
         cues: &FrameCues,
-        person: &PersonBox,
+        person: &BoundingBox,
         scratch: &mut HistogramScratch,
     ) -> bool {
         let rate = params.adapt_rate as f32;
@@ -290,7 +290,7 @@ impl Appearance {
         &self,
         params: &AppearanceParams,
         cues: &FrameCues,
-        person: &PersonBox,
+        person: &BoundingBox,
         scratch: &mut HistogramScratch,
     ) -> f64 {
         let Some(mut log) = self.colour_log_likelihood(params, cues, person, scratch) else {
@@ -317,7 +317,7 @@ impl Appearance {
 /// `reference`; `None` when `b` holds no pixel.
 fn squared_distance(
     bins: &BinImage,
-    b: PersonBox,
+    b: BoundingBox,
     reference: &[f32],
     stride: usize,
     h: &mut Vec<f32>,
@@ -329,7 +329,7 @@ fn squared_distance(
 
 /// The normalised histogram of the bins inside `b` (clipped to the image) into `out`; the
 /// number of pixels counted (0: nothing inside).
-fn box_histogram(bins: &BinImage, b: &PersonBox, stride: usize, out: &mut [f32]) -> usize {
+fn box_histogram(bins: &BinImage, b: &BoundingBox, stride: usize, out: &mut [f32]) -> usize {
     let region = BoxPx {
         x_min: b.left_px,
         y_min: b.top_px,
@@ -368,7 +368,7 @@ mod tests {
             adapt_min_log_likelihood: -15.0,
             ..AppearanceParams::default()
         };
-        let person = PersonBox::standing_on(Point2::new(20.0, 50.0), 16.0, 40.0);
+        let person = BoundingBox::standing_on(Point2::new(20.0, 50.0), 16.0, 40.0);
         let (red, blue) = ([200, 30, 30], [30, 30, 160]);
         let born = cues_with(&params, |y| if y < 30 { red } else { blue });
         let mut appearance = Appearance::capture(&params, &born, &person).unwrap();

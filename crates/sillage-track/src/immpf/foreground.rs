@@ -4,7 +4,7 @@
 
 use sillage_core::Image;
 
-use super::person_box::PersonBox;
+use sillage_core::BoundingBox;
 
 /// A summed-area table of a foreground mask: `sums[(y)(w+1) + x]` counts the foreground
 /// pixels above and left of `(x, y)`.
@@ -34,7 +34,7 @@ impl ForegroundShare {
 
     /// The share of the pixels of `b` (clipped to the image; pixel `(x, y)` inside when
     /// `left ≤ x < right`) that are foreground; `None` when no pixel is inside.
-    pub fn share(&self, b: &PersonBox) -> Option<f64> {
+    pub fn share(&self, b: &BoundingBox) -> Option<f64> {
         let clip = |v: f64, n: usize| v.ceil().clamp(0.0, n as f64) as usize;
         let (x0, x1) = (clip(b.left_px, self.width), clip(b.right_px(), self.width));
         let (y0, y1) = (
@@ -61,7 +61,7 @@ mod tests {
         let mask = Image::from_vec(w, h, pixels.clone()).unwrap();
         let mut table = ForegroundShare::default();
         table.fill(&mask);
-        let b = PersonBox {
+        let b = BoundingBox {
             left_px: 2.5,
             top_px: -1.0,
             width_px: 6.0,
@@ -81,7 +81,7 @@ mod tests {
             (share - on as f64 / all as f64).abs() < 1e-12,
             "{share} vs {on}/{all}"
         );
-        let outside = PersonBox { left_px: 20.0, ..b };
+        let outside = BoundingBox { left_px: 20.0, ..b };
         assert_eq!(table.share(&outside), None);
     }
 }

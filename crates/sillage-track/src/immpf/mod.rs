@@ -13,13 +13,11 @@ mod appearance;
 mod foreground;
 mod models;
 mod params;
-mod person_box;
 mod sizing;
 mod tracker;
 
 pub use appearance::{Appearance, AppearanceParams, FrameCues, HistogramScratch};
 pub use models::PedestrianMotion;
 pub use params::{DetectionLikelihoodParams, ModelName, PedestrianParams, ProposalParams};
-pub use person_box::PersonBox;
 pub use sizing::BoxSizing;
 pub use tracker::{Candidate, PedestrianEstimate, PedestrianFrame, PedestrianTracker};

@@ -5,7 +5,7 @@
 
 use sillage_core::{Homography, PedestrianSize, Point2};
 
-use super::person_box::PersonBox;
+use sillage_core::BoundingBox;
 
 /// The box-size rule of a run.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,14 +25,14 @@ pub enum BoxSizing {
 impl BoxSizing {
     /// The box of a person standing on `foot`; `own_size_px` (width, height) is the
     /// tracker's own size, used without a ground plane or where it is undefined.
-    pub fn box_at(&self, foot: Point2, own_size_px: (f64, f64)) -> PersonBox {
+    pub fn box_at(&self, foot: Point2, own_size_px: (f64, f64)) -> BoundingBox {
         let (width, height) = match self {
             Self::FromCandidate => own_size_px,
             Self::Ground { homography, adult } => {
                 adult.box_size_px(homography, foot).unwrap_or(own_size_px)
             }
         };
-        PersonBox::standing_on(foot, width, height)
+        BoundingBox::standing_on(foot, width, height)
     }
 
     /// The people a candidate box holds: itself without a ground plane; with one, the adults
@@ -40,7 +40,7 @@ impl BoxSizing {
     /// several adults: ⌊width / adult width + ¼⌋ of them), each sized by the ground plane. A
     /// candidate much shorter than an adult there (< 60 %: a torso without legs, whose bottom
     /// edge is no foot) holds nobody.
-    pub fn people_in(&self, candidate: &PersonBox) -> Vec<PersonBox> {
+    pub fn people_in(&self, candidate: &BoundingBox) -> Vec<BoundingBox> {
         let foot = candidate.foot();
         let Self::Ground { .. } = self else {
             return vec![*candidate];

@@ -15,15 +15,15 @@ use sillage_filter::{
 use super::appearance::{Appearance, FrameCues, HistogramScratch};
 use super::models::PedestrianMotion;
 use super::params::{ModelName, PedestrianParams, REVIVAL_GATE_AT_DEATH};
-use super::person_box::PersonBox;
 use super::sizing::BoxSizing;
+use sillage_core::BoundingBox;
 
 /// A box that may start a tracker: a motion blob or a detection, with its score (1 for
 /// blobs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Candidate {
     /// The box, px.
-    pub bbox: PersonBox,
+    pub bbox: BoundingBox,
     /// Detector score (larger is surer).
     pub score: f64,
 }
@@ -48,7 +48,7 @@ pub struct PedestrianEstimate {
     /// Tracker identity.
     pub track_id: TrackId,
     /// The box on the posterior mean foot point.
-    pub bbox: PersonBox,
+    pub bbox: BoundingBox,
     /// Posterior mean velocity of the foot point, px/frame.
     pub vel_px_per_frame: Vec2,
     /// πₘ, the weight of each model, in the order of `PedestrianParams::models`.
@@ -72,8 +72,8 @@ struct Track {
     /// Consecutive frames without a candidate on the tracker's box.
     unsupported_frames: u32,
     /// The detection matched this frame (detections-only mode).
-    matched: Option<PersonBox>,
-    bbox: PersonBox,
+    matched: Option<BoundingBox>,
+    bbox: BoundingBox,
     /// Frames lived, the birth frame included.
     age: u32,
     /// Estimates held until the tracker is confirmed (`confirm_frames`).
@@ -279,7 +279,7 @@ impl PedestrianTracker {
     /// overlaps most (greedy by IoU, at least `match_iou`); a matched tracker's size follows
     /// its detections.
     fn match_detections(&mut self, candidates: &[Candidate]) {
-        let boxes: Vec<PersonBox> = candidates.iter().map(|c| c.bbox).collect();
+        let boxes: Vec<BoundingBox> = candidates.iter().map(|c| c.bbox).collect();
         let pairs = self.match_predicted(&boxes, self.params.detection.match_iou);
         self.tracks.iter_mut().for_each(|t| t.matched = None);
         let alpha = self.params.detection.size_smoothing;
@@ -305,7 +305,7 @@ impl PedestrianTracker {
         if share <= 0.0 || self.tracks.is_empty() {
             return;
         }
-        let people: Vec<PersonBox> = candidates
+        let people: Vec<BoundingBox> = candidates
             .iter()
             .flat_map(|c| self.sizing.people_in(&c.bbox))
             .collect();
@@ -320,7 +320,7 @@ impl PedestrianTracker {
     /// Greedy one-to-one matching of the trackers' predicted boxes (on their posterior mean
     /// foot point) to `boxes`, best IoU first, pairs of IoU ≥ `min_iou` only; ties go to the
     /// lower tracker, then box, index. Returns (tracker, box) pairs.
-    fn match_predicted(&self, boxes: &[PersonBox], min_iou: f64) -> Vec<(usize, usize)> {
+    fn match_predicted(&self, boxes: &[BoundingBox], min_iou: f64) -> Vec<(usize, usize)> {
         let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
         for (t, track) in self.tracks.iter().enumerate() {
             let predicted = self
@@ -528,7 +528,7 @@ impl PedestrianTracker {
     fn revive(
         &mut self,
         frame: FrameIndex,
-        person: &PersonBox,
+        person: &BoundingBox,
         on_images: bool,
     ) -> Option<TrackId> {
         let foot = person.foot();

@@ -4,7 +4,7 @@
 
 use sillage_core::{Homography, Point2};
 
-use crate::immpf::PersonBox;
+use sillage_core::BoundingBox;
 
 /// Samples a Gaussian needs before it judges a candidate.
 const MIN_SAMPLES: u32 = 3;
@@ -58,7 +58,7 @@ impl WorldScale {
     }
 
     /// Where the box stands: its foot point on the ground (m) or in the image (px).
-    pub fn ground(&self, b: &PersonBox) -> Point2 {
+    pub fn ground(&self, b: &BoundingBox) -> Point2 {
         let foot = b.foot();
         self.homography
             .as_ref()
@@ -68,7 +68,7 @@ impl WorldScale {
 
     /// Width and height of the box, in metres at its foot point (px per metre across the
     /// view there) or in pixels.
-    pub fn size(&self, b: &PersonBox) -> (f64, f64) {
+    pub fn size(&self, b: &BoundingBox) -> (f64, f64) {
         match self
             .homography
             .as_ref()
@@ -130,7 +130,7 @@ mod tests {
 
     #[test]
     fn pixels_without_a_homography() {
-        let b = PersonBox {
+        let b = BoundingBox {
             left_px: 10.0,
             top_px: 20.0,
             width_px: 24.0,

@@ -7,7 +7,7 @@ use sillage_image::{DominantColours, SiftDescriptor};
 
 use super::coherence::Coherence;
 use super::feature::TrackedFeature;
-use crate::immpf::PersonBox;
+use sillage_core::BoundingBox;
 
 /// Where an object is in its life.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -29,7 +29,7 @@ pub struct HistoryEntry {
     /// The frame.
     pub frame: FrameIndex,
     /// The object's box.
-    pub bbox: PersonBox,
+    pub bbox: BoundingBox,
     /// True when a blob supported the object.
     pub linked: bool,
 }
@@ -40,9 +40,9 @@ pub struct TrackedObject {
     /// Its identity.
     pub id: TrackId,
     /// Its box in the current frame (predicted when unseen).
-    pub bbox: PersonBox,
+    pub bbox: BoundingBox,
     /// Its box in the previous frame (the velocity is learned from the step between them).
-    pub previous: PersonBox,
+    pub previous: BoundingBox,
     /// Life-cycle state.
     pub state: ObjectState,
     /// Its tracked features.
@@ -54,7 +54,7 @@ pub struct TrackedObject {
     pub has_merged: bool,
     /// While it shares its detection with other objects (its box then comes from its
     /// features' pre-merge layout): where it would be had it kept its pre-merge velocity.
-    pub merge_prediction: Option<PersonBox>,
+    pub merge_prediction: Option<BoundingBox>,
     /// Its dominant colours, from the last frame it had a blob of its own.
     pub colours: DominantColours,
     /// Its features' descriptors in the last frame it had a blob of its own: what a
@@ -72,7 +72,7 @@ pub struct TrackedObject {
 
 impl TrackedObject {
     /// A new intermediate object on `bbox` at `frame`.
-    pub fn new(id: TrackId, bbox: PersonBox, frame: FrameIndex) -> Self {
+    pub fn new(id: TrackId, bbox: BoundingBox, frame: FrameIndex) -> Self {
         Self {
             id,
             bbox,
@@ -104,7 +104,7 @@ impl TrackedObject {
     /// velocity: the reliability-weighted mean of its features' velocities (their particle
     /// filters'), steadier than the box, whose edges follow the blob's shape; with fewer than
     /// three features, the smoothed step of the box centre.
-    pub fn move_to(&mut self, bbox: PersonBox) {
+    pub fn move_to(&mut self, bbox: BoundingBox) {
         let (mut sum_w, mut u, mut v) = (0.0, 0.0, 0.0);
         for f in &self.features {
             let w = f.reliability().max(1e-6);
@@ -131,7 +131,7 @@ impl TrackedObject {
     /// feature at `(x, y)` with anchor `(a, b)` places the box's corner at
     /// `(x − a·w, y − b·h)`; the corners are averaged with the features' reliabilities as
     /// weights; the size is the pre-merge one. `None` without features.
-    pub fn box_from_features(&self) -> Option<PersonBox> {
+    pub fn box_from_features(&self) -> Option<BoundingBox> {
         let (w, h) = (self.bbox.width_px, self.bbox.height_px);
         let (mut sum_w, mut left, mut top) = (0.0, 0.0, 0.0);
         for f in &self.features {
@@ -141,7 +141,7 @@ impl TrackedObject {
             top += weight * (f.pos_px().y - b * h);
             sum_w += weight;
         }
-        (sum_w > 0.0).then(|| PersonBox {
+        (sum_w > 0.0).then(|| BoundingBox {
             left_px: left / sum_w,
             top_px: top / sum_w,
             width_px: w,
@@ -151,6 +151,6 @@ impl TrackedObject {
 }
 
 /// The centre of a box.
-fn centre(b: &PersonBox) -> Point2 {
+fn centre(b: &BoundingBox) -> Point2 {
     Point2::new(b.left_px + b.width_px / 2.0, b.top_px + b.height_px / 2.0)
 }

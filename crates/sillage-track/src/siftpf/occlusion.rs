@@ -10,7 +10,7 @@ use sillage_image::{DominantColours, SiftDescriptor};
 
 use super::object::TrackedObject;
 use super::params::AssociationParams;
-use crate::immpf::PersonBox;
+use sillage_core::BoundingBox;
 
 /// A descriptor farther than this from its nearest neighbour matches nothing, whatever the
 /// ratio (unrelated unit-length descriptors lie 0.9-1.3 apart).
@@ -20,7 +20,7 @@ const MATCH_MAX_DISTANCE: f32 = 0.7;
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResumeCandidate {
     /// Its box.
-    pub bbox: PersonBox,
+    pub bbox: BoundingBox,
     /// Descriptors of the keypoints detected on it.
     pub descriptors: Vec<SiftDescriptor>,
     /// Its dominant colours (empty without a colour frame).

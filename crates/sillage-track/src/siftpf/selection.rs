@@ -9,19 +9,19 @@ use sillage_image::SiftKeypoint;
 
 use super::feature::{FeatureFrame, FeatureSeed};
 use super::params::{FeaturePlacementParams, FeatureSelection};
-use crate::immpf::PersonBox;
+use sillage_core::BoundingBox;
 
 /// The grid of sub-regions of a box: `columns × rows` cells of equal size.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SubregionGrid {
-    bbox: PersonBox,
+    bbox: BoundingBox,
     columns: usize,
     rows: usize,
 }
 
 impl SubregionGrid {
     /// The grid of `bbox` with cells of about `subregion_px` (at least one cell).
-    pub fn new(bbox: PersonBox, subregion_px: f64) -> Self {
+    pub fn new(bbox: BoundingBox, subregion_px: f64) -> Self {
         let cells = |extent: f64| ((extent / subregion_px).round() as usize).max(1);
         Self {
             bbox,
@@ -85,12 +85,12 @@ pub fn robustness(
 /// What a selection needs to know about the object and its neighbours.
 pub struct SelectionRequest<'a> {
     /// The object's box.
-    pub bbox: PersonBox,
+    pub bbox: BoundingBox,
     /// Positions of the features the object already has.
     pub existing: &'a [Point2],
     /// Boxes of the other objects: sub-regions whose centre lies in one are shared and not
     /// used (§2.3).
-    pub others: &'a [PersonBox],
+    pub others: &'a [BoundingBox],
     /// `c₀` of the object (Eq. (5)).
     pub motion_confidence: f64,
 }
@@ -204,7 +204,7 @@ fn point(k: &SiftKeypoint) -> Point2 {
 }
 
 /// Position inside `bbox` as shares of its width and height.
-pub fn anchor_in(bbox: &PersonBox, p: Point2) -> (f64, f64) {
+pub fn anchor_in(bbox: &BoundingBox, p: Point2) -> (f64, f64) {
     (
         (p.x - bbox.left_px) / bbox.width_px,
         (p.y - bbox.top_px) / bbox.height_px,
@@ -212,7 +212,7 @@ pub fn anchor_in(bbox: &PersonBox, p: Point2) -> (f64, f64) {
 }
 
 /// The pixels a box covers (clamped at 0; the detector clips to the frame).
-fn pixel_box(b: &PersonBox) -> sillage_image::PixelBox {
+fn pixel_box(b: &BoundingBox) -> sillage_image::PixelBox {
     let floor = |v: f64| v.floor().max(0.0) as usize;
     let ceil = |v: f64| v.ceil().max(0.0) as usize + 1;
     sillage_image::PixelBox {
@@ -242,7 +242,7 @@ mod tests {
 
     #[test]
     fn grid_cells_cover_the_box() {
-        let b = PersonBox {
+        let b = BoundingBox {
             left_px: 10.0,
             top_px: 20.0,
             width_px: 24.0,

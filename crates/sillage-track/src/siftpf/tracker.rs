@@ -22,7 +22,7 @@ use super::occlusion::{ResumeCandidate, resume_pairs};
 use super::params::SiftPfParams;
 use super::selection::{FeatureSelector, SelectionRequest, anchor_in};
 use super::validation::is_object_of_interest;
-use crate::immpf::PersonBox;
+use sillage_core::BoundingBox;
 
 /// A free detection lying at least this share inside an object linked this frame is a
 /// fragment of it (legs or a head cut off by the background subtraction), not a newcomer.
@@ -54,7 +54,7 @@ pub struct SiftPfEstimate {
     /// Identity of the object.
     pub id: TrackId,
     /// The box.
-    pub bbox: PersonBox,
+    pub bbox: BoundingBox,
     /// True when the box was estimated from the features inside a merged detection.
     pub merged: bool,
 }
@@ -290,7 +290,7 @@ impl SiftPfTracker {
         self.handle_unlinked(input, links);
         retain_indices(&mut self.objects, |i| !ended[i]);
         // A detection mostly inside an object linked this frame is a fragment of it.
-        let linked_boxes: Vec<PersonBox> = links
+        let linked_boxes: Vec<BoundingBox> = links
             .iter()
             .enumerate()
             .filter_map(|(i, l)| match l {
@@ -357,7 +357,7 @@ impl SiftPfTracker {
     /// size, speed and signature are learned.
     fn update_alone(&mut self, i: usize, detection: &DetectedObject, input: &SiftPfFrame<'_>) {
         let bbox = person_box(detection);
-        let others: Vec<PersonBox> = self
+        let others: Vec<BoundingBox> = self
             .objects
             .iter()
             .enumerate()
@@ -409,7 +409,7 @@ impl SiftPfTracker {
     }
 
     /// Adds features to the sub-regions of object `i` that lack them (§2.1, §2.3).
-    fn replenish(&mut self, i: usize, input: &SiftPfFrame<'_>, others: &[PersonBox]) {
+    fn replenish(&mut self, i: usize, input: &SiftPfFrame<'_>, others: &[BoundingBox]) {
         let frame = FeatureFrame {
             sift: &self.sift,
             foreground: input.foreground,
@@ -559,7 +559,7 @@ impl SiftPfTracker {
             self.objects
                 .push(TrackedObject::new(id, person_box(detection), input.frame));
             let i = self.objects.len() - 1;
-            let others: Vec<PersonBox> = self.objects[..i]
+            let others: Vec<BoundingBox> = self.objects[..i]
                 .iter()
                 .filter(|o| o.is_active())
                 .map(|o| o.bbox)
@@ -646,8 +646,8 @@ fn scored_features(object: &TrackedObject) -> Vec<(Point2, f64)> {
 }
 
 /// How far (in box widths) the centre of `estimated` lies from that of `predicted`.
-fn predicted_offset(predicted: &PersonBox, estimated: &PersonBox) -> f64 {
-    let centre = |b: &PersonBox| (b.left_px + b.width_px / 2.0, b.top_px + b.height_px / 2.0);
+fn predicted_offset(predicted: &BoundingBox, estimated: &BoundingBox) -> f64 {
+    let centre = |b: &BoundingBox| (b.left_px + b.width_px / 2.0, b.top_px + b.height_px / 2.0);
     let (a, b) = (centre(predicted), centre(estimated));
     (a.0 - b.0).hypot(a.1 - b.1) / predicted.width_px.max(1.0)
 }
@@ -663,7 +663,7 @@ fn retain_indices<T>(items: &mut Vec<T>, keep: impl Fn(usize) -> bool) {
 
 /// `c₀` of Eq. (5) for an object: 1 when its box has no motion pixels, falling linearly to
 /// `min_confidence` when all of them move (§2.2.1: "for a low density, c₀ will be close to 1").
-fn motion_confidence(b: &PersonBox, foreground: &Image<bool>, min_confidence: f64) -> f64 {
+fn motion_confidence(b: &BoundingBox, foreground: &Image<bool>, min_confidence: f64) -> f64 {
     let (w, h) = foreground.dimensions();
     let x0 = b.left_px.max(0.0) as usize;
     let y0 = b.top_px.max(0.0) as usize;
@@ -680,8 +680,8 @@ fn motion_confidence(b: &PersonBox, foreground: &Image<bool>, min_confidence: f6
 }
 
 /// The box of a detection, px (its pixels span `[x0, x1 − 1]`).
-fn person_box(d: &DetectedObject) -> PersonBox {
-    PersonBox {
+fn person_box(d: &DetectedObject) -> BoundingBox {
+    BoundingBox {
         left_px: d.bbox.x0 as f64,
         top_px: d.bbox.y0 as f64,
         width_px: d.bbox.width() as f64,
@@ -690,7 +690,7 @@ fn person_box(d: &DetectedObject) -> PersonBox {
 }
 
 /// `b` moved (not resized) to lie inside `within` as far as it fits.
-fn clip_into(b: PersonBox, within: &PersonBox) -> PersonBox {
+fn clip_into(b: BoundingBox, within: &BoundingBox) -> BoundingBox {
     let place = |start: f64, size: f64, lo: f64, hi: f64| {
         if size >= hi - lo {
             start.clamp(hi - size, lo)
@@ -698,7 +698,7 @@ fn clip_into(b: PersonBox, within: &PersonBox) -> PersonBox {
             start.clamp(lo, hi - size)
         }
     };
-    PersonBox {
+    BoundingBox {
         left_px: place(b.left_px, b.width_px, within.left_px, within.right_px()),
         top_px: place(b.top_px, b.height_px, within.top_px, within.bottom_px()),
         ..b
@@ -706,7 +706,7 @@ fn clip_into(b: PersonBox, within: &PersonBox) -> PersonBox {
 }
 
 /// The share of `b`'s area inside `other`.
-fn inside_share(b: &PersonBox, other: &PersonBox) -> f64 {
+fn inside_share(b: &BoundingBox, other: &BoundingBox) -> f64 {
     let w = (b.right_px().min(other.right_px()) - b.left_px.max(other.left_px)).max(0.0);
     let h = (b.bottom_px().min(other.bottom_px()) - b.top_px.max(other.top_px)).max(0.0);
     let area = b.width_px * b.height_px;

@@ -33,7 +33,7 @@ pub fn is_object_of_interest(history: &[HistoryEntry], params: &ValidationParams
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::immpf::PersonBox;
+    use sillage_core::BoundingBox;
     use sillage_core::Point2;
 
     fn history(feet: &[(f64, bool)]) -> Vec<HistoryEntry> {
@@ -41,7 +41,7 @@ mod tests {
             .zip(0..)
             .map(|(&(x, linked), frame)| HistoryEntry {
                 frame,
-                bbox: PersonBox::standing_on(Point2::new(x, 50.0), 10.0, 30.0),
+                bbox: BoundingBox::standing_on(Point2::new(x, 50.0), 10.0, 30.0),
                 linked,
             })
             .collect()

@@ -1,13 +1,16 @@
-//! A person's box in the image, placed by its foot point: the tracked position of the
-//! pedestrian trackers is the bottom centre of the box, the point a ground-plane homography
-//! maps (§4 of the IMM-PF paper sizes boxes from the camera projection).
+//! The one box type of the toolkit: an axis-aligned box in the image, px, as MOTChallenge
+//! writes it (`bb_left, bb_top, bb_width, bb_height`). Pedestrian trackers place it by its
+//! foot point, the bottom centre that a ground-plane homography maps (§4 of the IMM-PF paper);
+//! metrics compare boxes by IoU.
 
-use sillage_core::Point2;
+use serde::{Deserialize, Serialize};
+
+use crate::Point2;
 
 /// An axis-aligned box, px: left/top corner, width and height (MOTChallenge's
-/// `bb_left, bb_top, bb_width, bb_height`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PersonBox {
+/// `bb_left, bb_top, bb_width, bb_height`, kept as written in a file).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BoundingBox {
     /// Left edge, px.
     pub left_px: f64,
     /// Top edge, px.
@@ -18,7 +21,7 @@ pub struct PersonBox {
     pub height_px: f64,
 }
 
-impl PersonBox {
+impl BoundingBox {
     /// The box of `width_px × height_px` standing on `foot` (its bottom centre).
     pub fn standing_on(foot: Point2, width_px: f64, height_px: f64) -> Self {
         Self {
@@ -37,6 +40,14 @@ impl PersonBox {
         )
     }
 
+    /// The box's centre.
+    pub fn centre(&self) -> Point2 {
+        Point2::new(
+            self.left_px + self.width_px / 2.0,
+            self.top_px + self.height_px / 2.0,
+        )
+    }
+
     /// Right edge, px.
     pub fn right_px(&self) -> f64 {
         self.left_px + self.width_px
@@ -48,7 +59,7 @@ impl PersonBox {
     }
 
     /// Intersection over union with `other`, in `[0, 1]` (0 for empty boxes).
-    pub fn iou(&self, other: &PersonBox) -> f64 {
+    pub fn iou(&self, other: &BoundingBox) -> f64 {
         let w = (self.right_px().min(other.right_px()) - self.left_px.max(other.left_px)).max(0.0);
         let h = (self.bottom_px().min(other.bottom_px()) - self.top_px.max(other.top_px)).max(0.0);
         let inter = w * h;
@@ -65,9 +76,9 @@ impl PersonBox {
     }
 
     /// The top or bottom half (the two colour histograms of §4.3).
-    pub fn half(&self, top: bool) -> PersonBox {
+    pub fn half(&self, top: bool) -> BoundingBox {
         let height_px = self.height_px / 2.0;
-        PersonBox {
+        BoundingBox {
             top_px: if top {
                 self.top_px
             } else {
@@ -94,17 +105,18 @@ mod tests {
 
     #[test]
     fn foot_iou_and_halves() {
-        let b = PersonBox::standing_on(Point2::new(50.0, 100.0), 20.0, 60.0);
+        let b = BoundingBox::standing_on(Point2::new(50.0, 100.0), 20.0, 60.0);
         assert_eq!(b.left_px, 40.0);
         assert_eq!(b.top_px, 40.0);
         assert_eq!(b.foot(), Point2::new(50.0, 100.0));
+        assert_eq!(b.centre(), Point2::new(50.0, 70.0));
         assert!((b.iou(&b) - 1.0).abs() < 1e-12);
-        let shifted = PersonBox { left_px: 50.0, ..b };
+        let shifted = BoundingBox { left_px: 50.0, ..b };
         assert!((b.iou(&shifted) - 1.0 / 3.0).abs() < 1e-12);
         assert_eq!(b.half(true).bottom_px(), 70.0);
         assert_eq!(b.half(false).top_px, 70.0);
         assert!(
-            !PersonBox {
+            !BoundingBox {
                 width_px: -1.0,
                 ..b
             }
