@@ -17,7 +17,6 @@ mod demo_bedload;
 mod detect;
 mod detect_motion;
 mod eulerian;
-mod eulerian_plots;
 mod eval;
 mod eval_inputs;
 mod eval_mot;
@@ -37,7 +36,6 @@ mod track_immpf;
 mod track_input;
 mod track_siftpf;
 mod tune;
-mod tune_http;
 mod view;
 
 use clap::Parser;

@@ -2,16 +2,14 @@
 //! motion state or id, velocity arrows at one frame, histograms of the displacements and of
 //! the log10 prediction errors, and counts of tracks and detections per frame.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Result, bail};
-use sillage::core::FrameIndex;
-use sillage::io::{read_detections_csv, write_png_rgb, write_text};
-use sillage::viz::{
-    Arrow, Curve, Histogram, LineChart, Plot, QuiverPlot, TrackColouring, TrackHistory,
-    TrajectoryPlot, speed_scale, velocity_px_per_frame,
+use sillage::plots::{
+    ColourBy, counts_chart, displacement_histogram, file_name, prediction_error_histogram,
+    quiver_plot, track_colouring, write_plot,
 };
+use sillage::viz::{Plot, TrackColouring, TrackHistory, TrajectoryPlot};
 
 use crate::cli::{ColourArg, PlotArgs, PlotKind, TracksInputArgs};
 use crate::track_input::read_tracks_for_drawing;
@@ -38,63 +36,33 @@ pub fn run(args: &PlotArgs) -> Result<()> {
     let (width, height) = args.size.0;
     let size = (width as u32, height as u32);
     let out = &args.out;
+    let (bins, log_y) = (args.bins, args.log_y);
     match args.kind {
         PlotKind::Trajectories => {
             let colouring = colouring(input, has_states, &history)?;
             let title = format!("{} tracks ({name})", history.len());
-            write_plot(
-                out,
-                &TrajectoryPlot {
-                    title,
-                    tracks: history,
-                    colouring,
-                },
-                size,
-            )
-        }
-        PlotKind::Quiver => write_plot(out, &quiver(&history, args.frame, &name)?, size),
-        PlotKind::Displacements => {
-            let values = history
-                .tracks()
-                .flat_map(|t| (0..t.len()).filter_map(move |i| velocity_px_per_frame(t, i)))
-                .map(|v| v.norm())
-                .collect();
-            let histogram = Histogram {
-                title: format!("Displacement per frame ({name})"),
-                x_label: "displacement (px/frame)".into(),
-                values,
-                bins: args.bins,
-                log_y: args.log_y,
+            let plot = TrajectoryPlot {
+                title,
+                tracks: history,
+                colouring,
             };
-            write_plot(out, &histogram, size)
+            write(out, &plot, size)
         }
-        PlotKind::PredictionError => {
-            let values: Vec<f64> = history
-                .tracks()
-                .flatten()
-                .filter_map(|p| p.log10_pred_err)
-                .collect();
-            if values.is_empty() {
-                bail!(
-                    "{}: no prediction error (log_err column) in this table; only `sillage ptv` \
-                     writes them",
-                    input.tracks.display()
-                );
-            }
-            let histogram = Histogram {
-                title: format!("Prediction error ({name})"),
-                x_label: "log10 prediction error (px)".into(),
-                values,
-                bins: args.bins,
-                log_y: args.log_y,
-            };
-            write_plot(out, &histogram, size)
-        }
-        PlotKind::Counts => write_plot(
+        PlotKind::Quiver => write(out, &quiver_plot(&history, args.frame, &name)?, size),
+        PlotKind::Displacements => write(
             out,
-            &counts(&history, input.detections.as_deref(), &name)?,
+            &displacement_histogram(&history, &name, bins, log_y),
             size,
         ),
+        PlotKind::PredictionError => {
+            let histogram =
+                prediction_error_histogram(&input.tracks, &history, &name, bins, log_y)?;
+            write(out, &histogram, size)
+        }
+        PlotKind::Counts => {
+            let chart = counts_chart(&history, input.detections.as_deref(), &name)?;
+            write(out, &chart, size)
+        }
     }
 }
 
@@ -105,126 +73,22 @@ pub fn colouring(
     has_states: bool,
     history: &TrackHistory,
 ) -> Result<TrackColouring> {
-    let default = if has_states {
-        ColourArg::State
-    } else {
-        ColourArg::Speed
-    };
-    Ok(match input.colour.unwrap_or(default) {
-        ColourArg::Speed => TrackColouring::Speed {
-            max_px_per_frame: speed_scale(history.tracks()),
-        },
-        ColourArg::State if !has_states => bail!(
-            "{}: the table has no motion states (a motion_state column: bedload tables); use \
-             --colour speed or --colour id",
-            input.tracks.display()
-        ),
-        ColourArg::State => TrackColouring::State,
-        ColourArg::Id => TrackColouring::Id,
-    })
+    let requested = input.colour.map(|colour| match colour {
+        ColourArg::Speed => ColourBy::Speed,
+        ColourArg::State => ColourBy::State,
+        ColourArg::Id => ColourBy::Id,
+    });
+    Ok(track_colouring(
+        &input.tracks,
+        requested,
+        has_states,
+        history,
+    )?)
 }
 
-/// Writes `plot` at `path` as PNG or SVG, after the extension.
-pub fn write_plot(path: &Path, plot: &impl Plot, (width, height): (u32, u32)) -> Result<()> {
-    let extension = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match extension.as_deref() {
-        Some("png") => write_png_rgb(path, &plot.to_rgb(width, height)?)?,
-        Some("svg") => write_text(path, &plot.to_svg(width, height)?)?,
-        _ => bail!(
-            "{}: give a picture file ending in .png or .svg",
-            path.display()
-        ),
-    }
+/// Writes `plot` at `path` (PNG or SVG, after the extension) and names the file.
+fn write(path: &Path, plot: &impl Plot, size: (u32, u32)) -> Result<()> {
+    write_plot(path, plot, size)?;
     eprintln!("{}", path.display());
     Ok(())
-}
-
-/// Velocity arrows at `frame`, or at the frame with the most tracks.
-fn quiver(history: &TrackHistory, frame: Option<FrameIndex>, name: &str) -> Result<QuiverPlot> {
-    let per_frame = points_per_frame(history);
-    let frame = match frame {
-        Some(frame) => frame,
-        // The first of the busiest frames.
-        None => per_frame
-            .iter()
-            .max_by_key(|&(f, n)| (*n, std::cmp::Reverse(*f)))
-            .map_or(0, |(f, _)| *f),
-    };
-    let arrows: Vec<Arrow> = history
-        .tracks()
-        .filter_map(|t| {
-            let i = t.iter().position(|p| p.frame == frame)?;
-            Some(Arrow {
-                pos_px: t[i].pos_px,
-                vel_px_per_frame: velocity_px_per_frame(t, i)?,
-            })
-        })
-        .collect();
-    if arrows.is_empty() {
-        let (first, last) = (per_frame.keys().next(), per_frame.keys().next_back());
-        bail!(
-            "{name}: no track with a velocity at frame {frame}; the tracks span frames {} to {} \
-             (0-based), give --frame in that range",
-            first.copied().unwrap_or(0),
-            last.copied().unwrap_or(0)
-        );
-    }
-    Ok(QuiverPlot {
-        title: format!("Velocities at frame {frame} ({name})"),
-        arrows,
-        length_per_speed: None,
-    })
-}
-
-/// Tracks per frame and, with `detections`, detections per frame, over every frame from the
-/// first to the last (zeros included).
-fn counts(history: &TrackHistory, detections: Option<&Path>, name: &str) -> Result<LineChart> {
-    let tracks = points_per_frame(history);
-    let detections: Option<BTreeMap<FrameIndex, usize>> = detections
-        .map(|path| {
-            let rows = read_detections_csv(path)?;
-            Ok::<_, anyhow::Error>(rows.into_iter().map(|(f, d)| (f, d.len())).collect())
-        })
-        .transpose()?;
-    let frames = tracks
-        .keys()
-        .chain(detections.iter().flat_map(|d| d.keys()));
-    let (first, last) = frames.fold((u64::MAX, 0), |(a, b), &f| (a.min(f), b.max(f)));
-    let curve = |label: &str, counts: &BTreeMap<FrameIndex, usize>| Curve {
-        label: label.into(),
-        points: (first..=last)
-            .map(|f| (f as f64, counts.get(&f).copied().unwrap_or(0) as f64))
-            .collect(),
-    };
-    let mut curves = Vec::new();
-    if let Some(d) = &detections {
-        curves.push(curve("detections", d));
-    }
-    curves.push(curve("tracks", &tracks));
-    Ok(LineChart {
-        title: format!("Per frame ({name})"),
-        x_label: "frame (0-based)".into(),
-        y_label: "count".into(),
-        curves,
-    })
-}
-
-/// Number of tracks with a point at each frame.
-fn points_per_frame(history: &TrackHistory) -> BTreeMap<FrameIndex, usize> {
-    let mut counts = BTreeMap::new();
-    for p in history.tracks().flatten() {
-        *counts.entry(p.frame).or_insert(0) += 1;
-    }
-    counts
-}
-
-/// The file name of `path`, for titles.
-pub fn file_name(path: &Path) -> String {
-    path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    )
 }

@@ -1,17 +1,14 @@
 //! `sillage synth vortex`: frames as 16-bit PNG and the ground truth as CSV.
 
-use std::path::{Path, PathBuf};
-
-use anyhow::{Context, Result};
-use sillage::io::TruthCsvWriter;
-use sillage::io::write_png16;
-use sillage::synth::vortex::{VortexParams, VortexSequence};
+use anyhow::Result;
+use sillage::synth::vortex::VortexParams;
+use sillage::vortex_files::write_vortex;
 
 use crate::cli::VortexArgs;
 use crate::progress::FrameProgress;
 
 /// The vortex parameters of the command line, on top of the generator's defaults.
-pub fn vortex_params(args: &VortexArgs) -> VortexParams {
+fn vortex_params(args: &VortexArgs) -> VortexParams {
     VortexParams {
         width: args.width,
         height: args.height,
@@ -26,31 +23,20 @@ pub fn vortex_params(args: &VortexArgs) -> VortexParams {
     }
 }
 
-/// Where frame `index` of a generated sequence is written.
-pub fn frame_path(dir: &Path, index: u64) -> PathBuf {
-    dir.join(format!("frame_{index:05}.png"))
-}
-
-/// Writes the sequence of `params` into `dir`: `frame_NNNNN.png` and `truth.csv`.
-pub fn write_vortex(params: &VortexParams, dir: &Path) -> Result<PathBuf> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the folder {}", dir.display()))?;
-    let truth_path = dir.join("truth.csv");
-    let mut truth = TruthCsvWriter::create(&truth_path)?;
+/// Writes the sequence of `params` into `dir` with a progress bar; returns the truth file.
+pub fn write_vortex_with_progress(
+    params: &VortexParams,
+    dir: &std::path::Path,
+) -> Result<std::path::PathBuf> {
     let mut progress = FrameProgress::new(Some(params.n_frames), "rendering");
-    for frame in VortexSequence::new(params.clone())? {
-        write_png16(frame_path(dir, frame.index), &frame.image)?;
-        truth.push(&frame.truth)?;
-        progress.tick();
-    }
+    let truth = write_vortex(params, dir, &mut || progress.tick());
     progress.finish();
-    truth.finish()?;
-    Ok(truth_path)
+    Ok(truth?)
 }
 
 /// `sillage synth vortex --out DIR`.
 pub fn run_vortex(args: &VortexArgs) -> Result<()> {
-    let truth = write_vortex(&vortex_params(args), &args.out)?;
+    let truth = write_vortex_with_progress(&vortex_params(args), &args.out)?;
     eprintln!(
         "{} frames written to {}, truth in {}",
         args.frames,

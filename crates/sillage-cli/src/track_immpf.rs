@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use sillage::detect::motion::MotionParams;
 use sillage::filter::MotionPrior;
 use sillage::io::{MotResultsWriter, MotRow, PartialFile};
+use sillage::overlay::PedestrianOverlays;
 use sillage::toml_config::{read_toml_file, set_key};
 use sillage::track::immpf::{
     BoxSizing, ModelName, PedestrianEstimate, PedestrianFrame, PedestrianParams, PedestrianTracker,
@@ -19,7 +20,6 @@ use sillage::track::immpf::{
 use crate::cli::TrackImmpfArgs;
 use crate::fit_pedestrian::read_motion_prior;
 use crate::ground_plane::GroundPlaneFile;
-use crate::overlay::PedestrianOverlays;
 use crate::pedestrian_input::{PedestrianInput, PreparedFrame, seqinfo_beside};
 use crate::progress::FrameProgress;
 
@@ -171,7 +171,7 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
             w.push(&estimates)?;
         }
         if let Some(o) = &mut overlays {
-            o.push(&prepared, &estimates)?;
+            o.push(prepared.frame, prepared.colour.as_ref(), &estimates)?;
         }
         input.recycle(prepared);
         rows += estimates.len() as u64;

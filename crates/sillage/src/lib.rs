@@ -19,10 +19,23 @@
 
 pub mod bedload;
 pub mod config;
+pub mod demo;
 pub mod detection_stage;
+pub mod eulerian;
+pub mod eulerian_bench;
+mod eulerian_plots;
+mod folders;
+pub mod overlay;
 pub mod pipeline;
+pub mod plots;
+pub mod process_memory;
+pub mod ptv_bench;
+pub mod ptv_run;
 pub mod toml_config;
 pub mod tractrac;
+pub mod tune;
+pub mod viewer;
+pub mod vortex_files;
 
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
 pub use detection_stage::DetectionStage;

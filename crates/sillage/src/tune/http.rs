@@ -1,4 +1,4 @@
-//! The little HTTP/1.1 that `sillage tune` needs, on the standard library alone: one request
+//! The little HTTP/1.1 that the tuning page needs, on the standard library alone: one request
 //! per connection (`Connection: close`), one thread per connection, bodies sized by
 //! `Content-Length`, headers and bodies bounded so a stray client cannot exhaust memory.
 

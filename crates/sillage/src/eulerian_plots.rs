@@ -1,14 +1,16 @@
-//! `sillage eulerian --plots DIR`: the per-bin fields as PNG heatmaps (the TracTrac paper's
+//! The plots of `sillage eulerian --plots DIR`: the per-bin fields as PNG heatmaps (the TracTrac paper's
 //! Fig. 6c: mean speed and turbulent kinetic energy; also the count, both mean velocity
 //! components and the Reynolds shear stress), and the profiles as line charts (Fig. 6d: mean
 //! velocity, and the Reynolds stresses, against the position across the flow).
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
-use sillage::eval::eulerian::{BinStats, EulerianGrid, ProfileAxis};
-use sillage::io::write_png_rgb;
-use sillage::viz::{Curve, HeatCell, Heatmap, LineChart, Plot};
+use sillage_core::Result;
+use sillage_eval::eulerian::{BinStats, EulerianGrid, ProfileAxis};
+use sillage_io::write_png_rgb;
+use sillage_viz::{Curve, HeatCell, Heatmap, LineChart, Plot};
+
+use crate::folders::create_folder;
 
 /// The value a heatmap shows for a bin.
 type Field = fn(&BinStats) -> f64;
@@ -18,14 +20,13 @@ const SIZE: (u32, u32) = (720, 600);
 
 /// Writes one heatmap per field into `dir`, and two line charts per profile (mean velocity;
 /// Reynolds stresses); returns the files written.
-pub fn write(
+pub fn write_eulerian_plots(
     dir: &Path,
     grid: &EulerianGrid,
     bins: &[BinStats],
     profiles: &[(ProfileAxis, Vec<BinStats>)],
 ) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    create_folder(dir)?;
     let calibrated = grid.params().calibration.is_some();
     let (length, velocity, stress) = if calibrated {
         ("m", "m/s", "m²/s²")

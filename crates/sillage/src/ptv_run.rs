@@ -1,0 +1,161 @@
+//! A PTV run from files to files: the configuration assembled as `sillage ptv` and
+//! `sillage config` assemble it, the track-file header that records it, and a whole run from a
+//! frame source into one track file (or any sink).
+
+use std::path::Path;
+
+use sillage_core::{Error, Result, TrackSink};
+use sillage_io::{
+    FrameOptions, FrameSource, TrackFileHeader, TrackFormat, WrittenSummary, create_track_writer,
+    open_frames, read_tractrac_par,
+};
+
+use crate::config::PipelineConfig;
+use crate::pipeline::{FrameReport, Pipeline, RunSummary};
+use crate::toml_config::{Settings, dotted_keys, load_unvalidated, set_key};
+use crate::tractrac::apply_par;
+
+impl Settings for PipelineConfig {
+    fn validate(&self) -> Result<()> {
+        PipelineConfig::validate(self)
+    }
+}
+
+/// The configuration of a PTV run: the defaults, then the TOML `file`, then the TracTrac
+/// `*_par.txt` at `tractrac_par`, then each `key=value` of `overrides`; validated.
+pub fn load_ptv_config(
+    file: Option<&Path>,
+    tractrac_par: Option<&Path>,
+    overrides: &[String],
+) -> Result<PipelineConfig> {
+    let mut config: PipelineConfig = load_unvalidated(file, &[])?;
+    if let Some(path) = tractrac_par {
+        let par = read_tractrac_par(path)?;
+        apply_par(&mut config, &par)
+            .map_err(|e| Error::input(format!("in {}: {e}", path.display())))?;
+    }
+    for assignment in overrides {
+        set_key(&mut config, assignment)?;
+    }
+    Settings::validate(&config)?;
+    Ok(config)
+}
+
+/// The header written into track files: our version and every parameter of `config` under
+/// its dotted key (`detector.scale_px`, `tracker.motion_av`), the keys `--set` takes.
+pub fn track_header(config: &PipelineConfig) -> Result<TrackFileHeader> {
+    Ok(TrackFileHeader {
+        program_version: format!("sillage {}", env!("CARGO_PKG_VERSION")),
+        parameters: dotted_keys(config)?,
+        ..TrackFileHeader::default()
+    })
+}
+
+/// A pipeline ready to track a frame source: built, its background primed, the frames open.
+pub struct PtvRun {
+    pipeline: Pipeline,
+    frames: FrameSource,
+    header: TrackFileHeader,
+    background_frames: Option<usize>,
+}
+
+/// What [`PtvRun::run_to_file`] did.
+#[derive(Debug, Clone)]
+pub struct PtvFileRun {
+    /// Frames, detections, points and timings.
+    pub summary: RunSummary,
+    /// The file written and its rows.
+    pub written: WrittenSummary,
+}
+
+impl PtvRun {
+    /// Builds the pipeline of `config` for the frames of `input` (folder, glob, TIFF stack or
+    /// video); with background subtraction, the model starts as the mean of the first frames
+    /// (TracTrac's Eq. (2)), read from a first opening of the source.
+    pub fn open(config: &PipelineConfig, input: &str) -> Result<Self> {
+        let mut pipeline = Pipeline::from_config(config)?;
+        let background_frames = if pipeline.background_init_frames() > 0 {
+            Some(pipeline.prime_background(open_frames(input, &FrameOptions::default())?)?)
+        } else {
+            None
+        };
+        Ok(Self {
+            pipeline,
+            frames: open_frames(input, &FrameOptions::default())?,
+            header: track_header(config)?,
+            background_frames,
+        })
+    }
+
+    /// How many frames the background model was initialised from (`None` without one).
+    pub fn background_frames(&self) -> Option<usize> {
+        self.background_frames
+    }
+
+    /// Number of frames to track, when the source knows it (not for every video).
+    pub fn frame_count(&self) -> Option<usize> {
+        self.frames.len()
+    }
+
+    /// The header of the track files of this run ([`track_header`]).
+    pub fn header(&self) -> &TrackFileHeader {
+        &self.header
+    }
+
+    /// Tracks every frame into `sink`; `on_frame` is called after each (progress bars).
+    pub fn run(
+        mut self,
+        sink: &mut dyn TrackSink,
+        on_frame: &mut dyn FnMut(&FrameReport),
+    ) -> Result<RunSummary> {
+        self.pipeline.run(self.frames, sink, on_frame)
+    }
+
+    /// Tracks every frame into the track file `out` in `format`. Rows written before an error
+    /// stay valid: the file is completed either way, then the error is returned.
+    pub fn run_to_file(
+        self,
+        out: &Path,
+        format: TrackFormat,
+        on_frame: &mut dyn FnMut(&FrameReport),
+    ) -> Result<PtvFileRun> {
+        let mut writer = create_track_writer(out, format, &self.header)?;
+        let outcome = self.run(writer.as_mut(), on_frame);
+        let written = writer.finish()?;
+        Ok(PtvFileRun {
+            summary: outcome?,
+            written,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_header_names_nested_keys_with_their_sections() {
+        let header = track_header(&PipelineConfig::default()).unwrap();
+        let keys: Vec<&str> = header.parameters.iter().map(|(k, _)| k.as_str()).collect();
+        assert!(keys.contains(&"tracker.motion_av"), "{keys:?}");
+        assert!(
+            keys.iter().any(|k| k.starts_with("detector.threshold.")),
+            "{keys:?}"
+        );
+        assert!(keys.contains(&"training_passes"), "{keys:?}");
+        assert!(header.program_version.starts_with("sillage "));
+    }
+
+    #[test]
+    fn overrides_come_after_the_file_and_are_validated() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("ptv.toml");
+        std::fs::write(&file, "training_passes = 1\n").unwrap();
+        let config = load_ptv_config(Some(&file), None, &["training_passes=2".into()]).unwrap();
+        assert_eq!(config.training_passes, 2);
+        let err = load_ptv_config(None, None, &["tracker.motion_av=0".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("motion_av"), "{err}");
+    }
+}
