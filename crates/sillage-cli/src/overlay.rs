@@ -147,7 +147,7 @@ impl PedestrianOverlays {
     /// the people estimated at that frame.
     pub fn push(
         &mut self,
-        prepared: &crate::pedestrian_input::PreparedFrame,
+        prepared: &sillage::pedestrian::PreparedFrame,
         estimates: &[PedestrianEstimate],
     ) -> Result<()> {
         let colour = prepared

@@ -20,6 +20,8 @@
 pub mod bedload;
 pub mod config;
 pub mod detection_stage;
+pub mod experiments;
+pub mod pedestrian;
 pub mod pipeline;
 pub mod toml_config;
 pub mod tractrac;
