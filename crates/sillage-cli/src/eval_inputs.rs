@@ -357,18 +357,6 @@ pub fn load_sequence(
     })
 }
 
-/// Reads the ground truth `gt` alone, as [`load_sequence`] does: the true objects and the
-/// `seqLength` of its `seqinfo.ini`, when there is one.
-pub fn load_truth(
-    gt: &Path,
-    rule: MatchRule,
-    protocol: MotChallengeProtocol,
-) -> Result<(Vec<MotTruth>, Option<u64>)> {
-    let (objects, frame_count) = read_objects(gt, true)?;
-    let (_, truth) = truth_of(&objects, gt, rule, protocol)?;
-    Ok((truth, frame_count))
-}
-
 /// The shapes `rule` compares and the true objects of `objects`, read from `gt`.
 fn truth_of(
     objects: &Objects,

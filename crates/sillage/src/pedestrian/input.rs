@@ -3,15 +3,14 @@
 //! (as birth candidates beside the frames, or alone in the detections-only mode).
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use anyhow::{Context, Result, bail, ensure};
-use sillage::core::BoundingBox;
-use sillage::core::{FrameIndex, GrayImage, RgbImage};
-use sillage::detect::motion::{MotionBlob, MotionDetector, MotionParams};
-use sillage::io::read_mot_rows;
-use sillage::io::{FrameOptions, FrameSource, open_frames};
-use sillage::track::immpf::{AppearanceParams, Candidate, FrameCues};
+use sillage_core::{BoundingBox, Error, FrameIndex, GrayImage, Result, RgbImage};
+use sillage_detect::motion::{MotionBlob, MotionDetector, MotionParams};
+use sillage_io::{FrameOptions, FrameSource, open_frames, read_mot_rows};
+use sillage_track::immpf::{AppearanceParams, Candidate, FrameCues};
+
+use super::within;
 
 /// One frame ready for the tracker.
 pub struct PreparedFrame {
@@ -48,12 +47,13 @@ pub struct PedestrianInput {
 /// Reads a MOTChallenge detections file as candidates by 0-based frame.
 pub fn read_candidates(path: &Path) -> Result<BTreeMap<FrameIndex, Vec<Candidate>>> {
     let rows = read_mot_rows(path)?;
-    ensure!(
-        !rows.is_empty(),
-        "{} holds no detection; give a MOTChallenge file with rows \
-         `frame,-1,left,top,width,height,score,...`",
-        path.display()
-    );
+    if rows.is_empty() {
+        return Err(Error::input(format!(
+            "{} holds no detection; give a MOTChallenge file with rows \
+             `frame,-1,left,top,width,height,score,...`",
+            path.display()
+        )));
+    }
     let mut frames: BTreeMap<FrameIndex, Vec<Candidate>> = BTreeMap::new();
     for row in rows {
         frames.entry(row.frame).or_default().push(Candidate {
@@ -69,13 +69,12 @@ pub fn read_candidates(path: &Path) -> Result<BTreeMap<FrameIndex, Vec<Candidate
     Ok(frames)
 }
 
-/// The frame size of a MOTChallenge sequence, from the `seqinfo.ini` beside the folder of
-/// `file` (`SEQ/det/det.txt` → `SEQ/seqinfo.ini`).
-pub fn seqinfo_beside(file: &Path) -> Option<(PathBuf, sillage::io::SeqInfo)> {
+/// The frame size (width, height), px, of a MOTChallenge sequence, from the `seqinfo.ini`
+/// beside the folder of `file` (`SEQ/det/det.txt` → `SEQ/seqinfo.ini`).
+pub fn frame_size_beside(file: &Path) -> Option<(usize, usize)> {
     let sequence = file.parent()?.parent()?;
-    let path = sequence.join("seqinfo.ini");
-    let info = sillage::io::read_seqinfo(&path).ok()?;
-    Some((path, info))
+    let info = sillage_io::read_seqinfo(sequence.join("seqinfo.ini")).ok()?;
+    Some((info.image_width? as usize, info.image_height? as usize))
 }
 
 impl PedestrianInput {
@@ -106,15 +105,15 @@ impl PedestrianInput {
             }
             None => {
                 let Some(found) = &detections else {
-                    bail!(
-                        "give frames to track, or --detections FILE for the detections-only mode"
-                    );
+                    return Err(Error::input(
+                        "give frames to track, or --detections FILE for the detections-only mode",
+                    ));
                 };
                 let Some(size) = frame_size_px else {
-                    bail!(
+                    return Err(Error::input(
                         "the detections-only mode needs the frame size: give --size WxH, or keep \
-                         the MOTChallenge layout SEQ/det/det.txt with SEQ/seqinfo.ini"
-                    );
+                         the MOTChallenge layout SEQ/det/det.txt with SEQ/seqinfo.ini",
+                    ));
                 };
                 let last = found.keys().next_back().copied().unwrap_or(0) + 1;
                 let end = max_frames.map_or(last, |m| last.min(m as u64));
@@ -165,14 +164,17 @@ impl PedestrianInput {
         let colour = frame
             .colour
             .as_ref()
-            .context("the frame source gave no colour pixels")?;
-        let context = || format!("{}: frame {}", frame.path.display(), frame.index + 1);
+            .ok_or_else(|| Error::input("the frame source gave no colour pixels"))?;
+        let context = |e| {
+            within(
+                format_args!("{}: frame {}", frame.path.display(), frame.index + 1),
+                e,
+            )
+        };
         let mut blobs = Vec::new();
         let foreground = match &mut self.motion {
             Some(detector) => {
-                detector
-                    .detect(&frame.image, &mut blobs)
-                    .with_context(context)?;
+                detector.detect(&frame.image, &mut blobs).map_err(context)?;
                 Some(detector.foreground())
             }
             None => None,
@@ -186,7 +188,7 @@ impl PedestrianInput {
             self.previous.as_ref(),
             foreground,
         )
-        .with_context(context)?;
+        .map_err(context)?;
         let candidates = match &self.detections {
             Some(_) => self.candidates_of(frame.index),
             None => blobs.iter().map(blob_candidate).collect(),

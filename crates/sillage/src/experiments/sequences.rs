@@ -1,19 +1,19 @@
 //! What the MOTChallenge paper benches (`bench immpf`, `bench siftpf`) share: a sequence
-//! folder's name and ground truth, and the matching of box estimates to it (IoU ≥ 0.5).
+//! folder's name, frames and ground truth, and the matching of box estimates to it
+//! (IoU ≥ 0.5).
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
-use sillage::core::BoundingBox;
-use sillage::core::FrameIndex;
-use sillage::eval::MotData;
-use sillage::eval::mot::{MotChallengeProtocol, MotEstimate, MotTruth, Shape};
+use sillage_core::BoundingBox;
+use sillage_core::{Error, FrameIndex, Result};
+use sillage_eval::MotData;
+use sillage_eval::mot::{MotChallengeProtocol, MotEstimate, MotTruth, Shape, Similarity};
+use sillage_io::{MotFileRole, read_mot_sequence};
 
-use crate::cli::MatchRule;
-use crate::eval_inputs::load_truth;
+use crate::pedestrian::within;
 
 /// Boxes match when their IoU is at least 0.5 (CLEAR MOT's usual rule, and the papers').
-const BOX_MATCH: MatchRule = MatchRule::Iou { threshold: 0.5 };
+const BOX_MATCH: Similarity = Similarity::BoxIou;
 
 /// A sequence folder's name: its last path component.
 pub fn sequence_name(folder: &Path) -> String {
@@ -31,17 +31,49 @@ pub struct SequenceTruth {
 }
 
 impl SequenceTruth {
-    /// Reads `folder/gt/gt.txt` (and the `seqinfo.ini` beside it).
+    /// Reads `folder/gt/gt.txt` (and the `seqinfo.ini` beside it): the boxes of every row,
+    /// scored or skipped by the MOT15 protocol.
     pub fn load(folder: &Path) -> Result<Self> {
         let gt = folder.join("gt").join("gt.txt");
-        let (truth, frame_count) = load_truth(&gt, BOX_MATCH, MotChallengeProtocol::Mot15)
-            .with_context(|| {
-                format!(
-                    "cannot read the ground truth of {}; a sequence folder holds gt/gt.txt",
-                    folder.display()
-                )
-            })?;
-        Ok(Self { truth, frame_count })
+        let context = |e| {
+            let what = format!(
+                "cannot read the ground truth of {}; a sequence folder holds gt/gt.txt",
+                folder.display()
+            );
+            within(what, e)
+        };
+        let file = read_mot_sequence(&gt, MotFileRole::GroundTruth).map_err(context)?;
+        let truth = file
+            .rows
+            .iter()
+            .map(|r| {
+                let id = r.id.ok_or_else(|| {
+                    Error::input(format!(
+                        "{}: a row of frame {} has id -1; every row needs an object or track \
+                         id in column 2",
+                        gt.display(),
+                        r.frame + 1
+                    ))
+                })?;
+                Ok(MotTruth {
+                    frame: r.frame,
+                    id,
+                    shape: Shape::Box(BoundingBox {
+                        left_px: r.left_px,
+                        top_px: r.top_px,
+                        width_px: r.width_px,
+                        height_px: r.height_px,
+                    }),
+                    role: MotChallengeProtocol::Mot15
+                        .truth_role(r.confidence.unwrap_or(1.0), r.class),
+                })
+            })
+            .collect::<Result<_>>()
+            .map_err(context)?;
+        Ok(Self {
+            truth,
+            frame_count: file.seqinfo.and_then(|info| info.frame_count),
+        })
     }
 
     /// The evaluation data of `boxes` (`(frame, id, box)`, 0-based frames) against the
@@ -65,12 +97,12 @@ impl SequenceTruth {
                 shape: Shape::Box(bbox),
             })
             .collect();
-        Ok(MotData::new(
+        MotData::new(
             &truth,
             &estimates,
-            BOX_MATCH.similarity(),
+            BOX_MATCH,
             self.frame_count.map(|n| n.min(frames)),
-        )?)
+        )
     }
 }
 
@@ -91,15 +123,15 @@ pub fn sequence_frames(folder: &Path) -> Result<String> {
     videos.sort();
     match videos.as_slice() {
         [video] => Ok(video.to_string_lossy().into_owned()),
-        [] => bail!(
+        [] => Err(Error::input(format!(
             "{} has no frames: neither an img1/ folder of images nor a video/*.mp4; put the \
              frames in img1/ (MOTChallenge layout) or one video in video/",
             folder.display()
-        ),
-        _ => bail!(
+        ))),
+        _ => Err(Error::input(format!(
             "{} holds {} videos; keep one, or put the frames in img1/",
             videos_dir.display(),
             videos.len()
-        ),
+        ))),
     }
 }
