@@ -226,8 +226,8 @@ impl TuneSession {
                 .map(|d| [round_centi(d.pos_px.x), round_centi(d.pos_px.y), d.strength])
                 .collect(),
             histogram: maxima_histogram(
-                stage.filtered(),
-                blob_params(&config).neighbourhood,
+                stage.filtered().context("no band-passed image")?,
+                blob_params(&config)?.neighbourhood,
                 threshold,
             ),
             detect_ms,
@@ -240,7 +240,8 @@ impl TuneSession {
         let config = parse_config(config)?;
         let (stage, _, _) = self.run_stage(index, &config)?;
         let (width, height) = self.frames[index].image.dimensions();
-        let placed = place_in_frame(stage.filtered(), blob_params(&config).roi, width, height);
+        let filtered = stage.filtered().context("no band-passed image")?;
+        let placed = place_in_frame(filtered, blob_params(&config)?.roi, width, height);
         Ok(Response::bytes("image/png", encode_png(&placed)?))
     }
 
@@ -283,13 +284,16 @@ fn parse_config(value: serde_json::Value) -> Result<PipelineConfig> {
     let config: PipelineConfig =
         serde_json::from_value(value).context("the configuration does not parse")?;
     config.validate()?;
+    blob_params(&config)?;
     Ok(config)
 }
 
-/// The blob detector's parameters of `config`.
-fn blob_params(config: &PipelineConfig) -> &BlobParams {
-    let sillage::DetectorConfig::Blob(params) = &config.detector;
-    params
+/// The blob detector's parameters of `config`, the one detector `sillage tune` tunes.
+fn blob_params(config: &PipelineConfig) -> Result<&BlobParams> {
+    match &config.detector {
+        sillage::DetectorConfig::Blob(params) => Ok(params),
+        _ => anyhow::bail!("`sillage tune` tunes the blob detector; set detector.kind = \"blob\""),
+    }
 }
 
 /// `filtered`, the band-passed image of `roi` (the whole frame when `None`), placed in a

@@ -20,13 +20,15 @@
 pub mod bedload;
 pub mod config;
 pub mod detection_stage;
+/// The papers' experiments: what the `bench` and `demo` commands compute.
+pub mod experiments;
 pub mod pipeline;
 pub mod toml_config;
 pub mod tractrac;
 
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
 pub use detection_stage::DetectionStage;
-pub use pipeline::{FrameInput, FrameReport, Pipeline, RunSummary};
+pub use pipeline::{FrameInput, FrameObserver, FrameReport, Pipeline, RunSummary};
 
 pub use sillage_assoc as assoc;
 pub use sillage_core as core;
