@@ -1,63 +1,18 @@
 //! `sillage demo bedload`: a synthetic bedload sequence rendered to PNG frames, the beads
 //! detected from the files, tracked with MMPF+, written in BeadTracking's layout and scored
-//! against the truth as the MMPF+ paper scores (Table 1).
+//! against the truth as the MMPF+ paper scores (Table 1). The steps are
+//! `sillage::experiments::bedload::demo`'s; this shows their progress and prints the scores.
 
-use std::time::Instant;
-
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::Serialize;
-use sillage::core::{GrayImage, TrackPoint, TrackSink, Tracker};
-use sillage::detect::{BeadDetections, BeadDetector, BeadParams};
+use sillage::bedload::synth::synthetic_radii;
 use sillage::eval::papers::{BeadTrackScores, score_bead_tracks};
-use sillage::io::{
-    BeadCsvWriter, BeadSequenceParams, FrameOptions, open_frames, write_bead_sequence_params,
-    write_png16,
-};
-use sillage::synth::{BedloadRenderParams, BedloadRenderer, BedloadScene, BedloadSceneParams};
-use sillage::track::bedload::{BedloadTracker, BedloadTrackerParams};
+use sillage::experiments::bedload::demo::{demo_scene, frames_dir, render, track};
 use sillage::viz::OverlayStyle;
 
 use crate::cli::DemoBedloadArgs;
-use crate::overlay::{DetectionsByFrame, write_overlays};
+use crate::overlay::write_overlays;
 use crate::progress::FrameProgress;
-
-/// Scale of the synthetic sequence (the authors' example), m/px.
-const M_PER_PX: f64 = 2.056e-4;
-
-/// The bead radius of each class of a generated scene (black, transparent), px.
-pub fn synthetic_radii(scene: &BedloadSceneParams) -> [f64; 2] {
-    [scene.black_radius_px, scene.transparent_radius_px]
-}
-
-/// The sequence parameters of a generated scene, as BeadTracking writes them.
-fn synthetic_sequence_params(scene: &BedloadSceneParams) -> BeadSequenceParams {
-    let radii = synthetic_radii(scene);
-    BeadSequenceParams {
-        black_diameter_m: 2.0 * radii[0] * M_PER_PX,
-        transparent_diameter_m: 2.0 * radii[1] * M_PER_PX,
-        m_per_px: M_PER_PX,
-    }
-}
-
-/// The bead detector with its default (real-frame) parameters at the scene's sizes; the
-/// transparent beads and the candidates above `transparent_threshold` when given.
-pub fn synthetic_detector(
-    scene: &BedloadSceneParams,
-    transparent_threshold: Option<f64>,
-) -> Result<BeadDetector> {
-    let sequence = synthetic_sequence_params(scene);
-    let mut params = BeadParams {
-        m_per_px: sequence.m_per_px,
-        black_diameter_m: sequence.black_diameter_m,
-        transparent_diameter_m: sequence.transparent_diameter_m,
-        ..BeadParams::default()
-    };
-    if let Some(threshold) = transparent_threshold {
-        params.transparent_threshold = threshold;
-        params.candidate_threshold = threshold;
-    }
-    Ok(BeadDetector::new(params)?)
-}
 
 /// The demo's summary.
 #[derive(Serialize)]
@@ -71,93 +26,31 @@ struct DemoBedloadSummary {
 
 /// `sillage demo bedload`.
 pub fn run(args: &DemoBedloadArgs) -> Result<()> {
-    let scene_params = BedloadSceneParams {
-        n_frames: args.frames,
-        seed: args.seed,
-        ..BedloadSceneParams::default()
-    };
-    let frames_dir = args.out.join("frames");
-    std::fs::create_dir_all(&frames_dir)
-        .with_context(|| format!("cannot create the folder {}", frames_dir.display()))?;
+    let scene = demo_scene(args.frames, args.seed);
+    let frames_dir = frames_dir(&args.out);
     eprintln!(
         "1/3 synthetic bedload flume (MMPF+ paper): {} black and {} transparent beads, {} frames \
          of {}×{} → {}",
-        scene_params.n_black,
-        scene_params.n_transparent,
-        scene_params.n_frames,
-        scene_params.width,
-        scene_params.height,
+        scene.n_black,
+        scene.n_transparent,
+        scene.n_frames,
+        scene.width,
+        scene.height,
         frames_dir.display()
     );
-    let radii = synthetic_radii(&scene_params);
-    write_bead_sequence_params(
-        args.out.join("sequence_param.txt"),
-        &synthetic_sequence_params(&scene_params),
-    )?;
-    let mut renderer = BedloadRenderer::new(BedloadRenderParams::default())?;
-    let mut image = GrayImage::new(scene_params.width, scene_params.height);
-    let mut truth_writer = BeadCsvWriter::create(args.out.join("truth.csv"))?;
-    let mut truth: Vec<TrackPoint> = Vec::new();
-    let mut progress = FrameProgress::new(Some(scene_params.n_frames), "rendering");
-    for frame in BedloadScene::new(scene_params.clone())? {
-        renderer.render(&frame, &mut image);
-        write_png16(
-            frames_dir.join(format!("frame_{:05}.png", frame.index)),
-            &image,
-        )?;
-        let start = truth.len();
-        truth.extend(frame.track_points());
-        truth_writer.accept(&truth[start..])?;
-        progress.tick();
-    }
+    let mut progress = FrameProgress::new(Some(scene.n_frames), "rendering");
+    let truth = render(&args.out, &scene, &mut || progress.tick());
     progress.finish();
-    truth_writer.finish()?;
+    let truth = truth?;
 
     eprintln!("2/3 detecting the beads in the PNG frames and tracking them with MMPF+");
-    let mut detector = synthetic_detector(&scene_params, None)?;
-    let params = BedloadTrackerParams {
-        radius_px: radii.to_vec(),
-        seed: args.seed,
-        ..BedloadTrackerParams::default()
-    };
-    let mut tracker = BedloadTracker::new(&params)?;
-    let tracks_path = args.out.join("tracks.csv");
-    let mut writer = BeadCsvWriter::create(&tracks_path)?;
-    let mut tracks: Vec<TrackPoint> = Vec::new();
-    let frames = open_frames(&frames_dir.to_string_lossy(), &FrameOptions::default())?;
-    let mut progress = FrameProgress::new(frames.len(), "tracking");
-    let mut beads = BeadDetections::default();
-    let mut detections = Vec::new();
-    let mut kept = DetectionsByFrame::new();
-    let (mut detect_s, mut track_s) = (0.0, 0.0);
-    for frame in frames {
-        let frame = frame?;
-        let start = Instant::now();
-        detector.detect_beads(&frame.image, &mut beads)?;
-        detect_s += start.elapsed().as_secs_f64();
-        detections.clear();
-        detections.extend_from_slice(&beads.black);
-        detections.extend_from_slice(&beads.transparent);
-        if args.overlays {
-            kept.insert(frame.index, detections.clone());
-        }
-        let observations = sillage::core::FrameObservations {
-            candidates: &beads.candidates,
-            ..sillage::core::FrameObservations::from_detections(frame.index, &detections)
-        };
-        let start = Instant::now();
-        let before = tracks.len();
-        tracker.step(&observations, &mut tracks)?;
-        track_s += start.elapsed().as_secs_f64();
-        writer.accept(&tracks[before..])?;
-        progress.tick();
-    }
+    let mut progress = FrameProgress::new(Some(scene.n_frames), "tracking");
+    let tracks = track(&args.out, &scene, args.seed, args.overlays, &mut |_| {
+        progress.tick()
+    });
     progress.finish();
-    // Points the tracker held back (predictions through misses) are flushed at the end.
-    let n_stepped = tracks.len();
-    tracker.finish(&mut tracks)?;
-    writer.accept(&tracks[n_stepped..])?;
-    writer.finish()?;
+    let tracks = tracks?;
+    let radii = synthetic_radii(&scene);
     if args.overlays {
         let dir = args.out.join("overlays");
         let style = OverlayStyle {
@@ -167,22 +60,20 @@ pub fn run(args: &DemoBedloadArgs) -> Result<()> {
         write_overlays(
             &frames_dir.to_string_lossy(),
             &dir,
-            &kept,
-            tracks.clone(),
+            &tracks.detections,
+            tracks.points.clone(),
             &style,
             None,
         )?;
     }
 
     eprintln!("3/3 scoring against the truth (disc IoU ≥ 0.43, MMPF+ paper §5.3)");
-    let scores = score_bead_tracks(&truth, &tracks, &radii)?;
-    let n = args.frames.max(1) as f64;
     let summary = DemoBedloadSummary {
         frames: args.frames,
-        detect_ms_per_frame: 1e3 * detect_s / n,
-        track_ms_per_frame: 1e3 * track_s / n,
-        scores,
-        tracks: tracks_path.display().to_string(),
+        detect_ms_per_frame: tracks.run.detect_ms_per_frame,
+        track_ms_per_frame: tracks.run.track_ms_per_frame,
+        scores: score_bead_tracks(&truth, &tracks.points, &radii)?,
+        tracks: tracks.path.display().to_string(),
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);

@@ -3,10 +3,8 @@
 //! Exit codes: 0 on success, 1 on a user error (the message names the file, line or frame and
 //! the fix), 2 on a bad command line.
 
-mod bead_output;
 mod bench;
 mod bench_bedload;
-mod bench_bedload_plots;
 mod bench_eulerian;
 mod bench_immpf;
 mod bench_siftpf;

@@ -1,34 +1,30 @@
 //! `sillage track bedload`: the bedload trackers (MMPF+ and the baselines of its Table 1) on
-//! detections read from CSV, or on frames through the bead detector; trajectories written in
-//! BeadTracking's layout or as a track table with motion states.
+//! detections read from CSV, or on frames through the bead detector, run by the facade's
+//! `Pipeline`; trajectories written in BeadTracking's layout or as a track table with motion
+//! states.
 
-use std::collections::BTreeMap;
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use sillage::core::{Detection, FrameIndex, FrameObservations, Tracker};
-use sillage::detect::BeadDetections;
-use sillage::io::{FrameOptions, open_frames, read_detections_csv};
-use sillage::toml_config::{read_toml_file, set_key};
-use sillage::track::bedload::{BedloadTracker, BedloadTrackerParams};
+use sillage::bedload::detector::BeadDetectorSources;
+use sillage::bedload::output::{BeadTrackKind, BeadTrackOutput};
+use sillage::bedload::read_bead_frames;
+use sillage::io::{FrameOptions, TrackFormat, open_frames};
+use sillage::toml_config::load_unvalidated;
+use sillage::track::bedload::BedloadTrackerParams;
 use sillage::viz::OverlayStyle;
+use sillage::{DetectorConfig, FrameInput, Pipeline, PipelineConfig, TrackerConfig};
 
-use crate::bead_output::BeadTrackOutput;
-use crate::cli::TrackBedloadArgs;
-use crate::detect::{build_detector, detect_frame};
+use crate::cli::{BeadFormatArg, TrackBedloadArgs};
 use crate::overlay::{DetectionsByFrame, write_overlays};
 use crate::progress::FrameProgress;
 
 /// Defaults, then `--config`, then `--set`, then `--tracker` and `--seed`; validated.
 pub fn load_bedload_params(args: &TrackBedloadArgs) -> Result<BedloadTrackerParams> {
-    let mut params: BedloadTrackerParams = match &args.config {
-        Some(path) => read_toml_file(path)?,
-        None => BedloadTrackerParams::default(),
-    };
-    for assignment in &args.overrides {
-        set_key(&mut params, assignment)?;
-    }
+    let mut params: BedloadTrackerParams =
+        load_unvalidated(args.config.as_deref(), &args.overrides)?;
     if let Some(kind) = args.tracker {
         params.tracker = kind.into();
     }
@@ -54,10 +50,15 @@ struct TrackSummary {
     out: String,
 }
 
-/// The detections and candidates of each frame, in frame order.
-type FrameInputs = BTreeMap<FrameIndex, (Vec<Detection>, Vec<Detection>)>;
+/// The frames to track (their number when known).
+type Inputs = (
+    Option<usize>,
+    Box<dyn Iterator<Item = sillage::core::Result<FrameInput>>>,
+);
 
-fn read_inputs(args: &TrackBedloadArgs, detections: &std::path::Path) -> Result<FrameInputs> {
+/// The frames of `--detections` (with `--candidates`), refusing an `--out` that would
+/// overwrite one of them.
+fn read_inputs(args: &TrackBedloadArgs, detections: &Path) -> Result<Inputs> {
     let inputs = std::iter::once(detections).chain(args.candidates.as_deref());
     for input in inputs {
         let same = match (input.canonicalize(), args.out.canonicalize()) {
@@ -71,88 +72,58 @@ fn read_inputs(args: &TrackBedloadArgs, detections: &std::path::Path) -> Result<
             input.display()
         );
     }
-    let mut frames = FrameInputs::new();
-    for (frame, found) in read_detections_csv(detections)? {
-        frames.entry(frame).or_default().0 = found;
-    }
-    if let Some(path) = &args.candidates {
-        for (frame, candidates) in read_detections_csv(path)? {
-            frames.entry(frame).or_default().1 = candidates;
-        }
-    }
-    anyhow::ensure!(
-        !frames.is_empty(),
-        "{} holds no detection; give a file with rows `frame,x,y,class,score`",
-        detections.display()
-    );
-    Ok(frames)
+    let frames = read_bead_frames(detections, args.candidates.as_deref())?;
+    Ok((
+        Some(frames.len()),
+        Box::new(frames.into_iter().map(|f| Ok(f.into()))),
+    ))
 }
 
-/// One frame of input: its index, detections and candidates.
-type FrameInput = (FrameIndex, Vec<Detection>, Vec<Detection>);
-
-/// The frames to track (their number when known) and the input of each.
-type FrameStream = (Option<usize>, Box<dyn Iterator<Item = Result<FrameInput>>>);
-
-/// The frames of `input`, each detected by the bead detector of the command line.
-fn detected_frames(args: &TrackBedloadArgs, input: &str) -> Result<FrameStream> {
-    let mut detector = build_detector(&args.detector)?;
-    let frames = open_frames(input, &FrameOptions::default())?;
-    let total = frames.len();
-    let mut beads = BeadDetections::default();
-    let detected = frames.map(move |frame| {
-        let frame = frame?;
-        detect_frame(&mut detector, &frame, &mut beads)?;
-        let mut found = beads.black.clone();
-        found.extend_from_slice(&beads.transparent);
-        Ok((frame.index, found, beads.candidates.clone()))
-    });
-    Ok((total, Box::new(detected)))
+/// The track file kind of `--format` (`None`: from the extension of `--out`).
+fn output_kind(format: Option<BeadFormatArg>) -> Option<BeadTrackKind> {
+    format.map(|format| match format {
+        BeadFormatArg::Beads => BeadTrackKind::Beads,
+        BeadFormatArg::Csv => BeadTrackKind::Table(TrackFormat::Csv),
+        BeadFormatArg::Parquet => BeadTrackKind::Table(TrackFormat::Parquet),
+        BeadFormatArg::Hdf5 => BeadTrackKind::Table(TrackFormat::Hdf5),
+    })
 }
 
-/// `sillage track bedload --detections FILE --out FILE`.
+/// `sillage track bedload [FRAMES | --detections FILE] --out FILE`.
 pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     let params = load_bedload_params(args)?;
-    let (total, frames): FrameStream = match (&args.input, &args.detections) {
-        (Some(input), _) => detected_frames(args, input)?,
-        (None, Some(detections)) => {
-            let inputs = read_inputs(args, detections)?;
-            let total = inputs.len();
-            let frames = inputs.into_iter().map(|(f, (d, c))| Ok((f, d, c)));
-            (Some(total), Box::new(frames))
+    let mut config = PipelineConfig {
+        tracker: TrackerConfig::Bedload(params.clone()),
+        ..PipelineConfig::default()
+    };
+    let (total, inputs): Inputs = match (&args.input, &args.detections) {
+        (Some(input), _) => {
+            let sources = BeadDetectorSources::from(&args.detector);
+            config.detector = DetectorConfig::Bead(sources.load()?);
+            let frames = open_frames(input, &FrameOptions::default())?;
+            (
+                frames.len(),
+                Box::new(frames.map(|f| f.map(FrameInput::Image))),
+            )
         }
+        (None, Some(detections)) => read_inputs(args, detections)?,
         (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
     };
-    let mut tracker = BedloadTracker::new(&params)?;
-    let mut writer = BeadTrackOutput::create(&args.out, args.format, &params)?;
+    let mut pipeline = Pipeline::from_config(&config)?;
+    let mut writer = BeadTrackOutput::create(&args.out, output_kind(args.format), &params)?;
     let kind = writer.kind();
     let mut progress = FrameProgress::new(total, "tracking");
     let start = Instant::now();
-    let mut outcome = Ok(());
     let (mut n_detections, mut n_candidates) = (0, 0);
     let mut kept = DetectionsByFrame::new();
-    for input in frames {
-        let step = input.and_then(|(frame, detections, candidates)| {
-            n_detections += detections.len();
-            n_candidates += candidates.len();
-            if args.overlay.is_some() {
-                kept.insert(frame, detections.clone());
-            }
-            let observations = FrameObservations {
-                candidates: &candidates,
-                ..FrameObservations::from_detections(frame, &detections)
-            };
-            Ok(tracker.step(&observations, &mut writer)?)
-        });
-        if let Err(e) = step {
-            outcome = Err(e);
-            break;
+    let outcome = pipeline.run_inputs(inputs, &mut writer, &mut |report, observations| {
+        n_detections += report.detections;
+        n_candidates += report.candidates;
+        if args.overlay.is_some() {
+            kept.insert(report.frame, observations.detections.to_vec());
         }
         progress.tick();
-    }
-    if outcome.is_ok() {
-        outcome = tracker.finish(&mut writer).map_err(anyhow::Error::from);
-    }
+    });
     progress.finish();
     let elapsed = start.elapsed().as_secs_f64();
     // Rows written before an error stay valid: the file is completed either way.
@@ -173,7 +144,7 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
         let n = write_overlays(input, dir, &kept, tracks, &style, None)?;
         eprintln!("{n} overlays → {}", dir.display());
     }
-    let stats = tracker.stats();
+    let stats = pipeline.bedload_stats().unwrap_or_default();
     let summary = TrackSummary {
         tracker: params.tracker.name(),
         frames: stats.frames,

@@ -317,7 +317,9 @@ fn tune_threshold_slider_changes_the_count_and_save_writes_it() {
     );
     browser.wait_for("return document.getElementById('saved').textContent.startsWith('saved to')");
     let written = PipelineConfig::from_toml_file(&saved).unwrap();
-    let DetectorConfig::Blob(params) = written.detector;
+    let DetectorConfig::Blob(params) = written.detector else {
+        panic!("saved detector {:?}", written.detector);
+    };
     match params.threshold {
         Threshold::Noise { k } => {
             assert!((k - k_high).abs() < 1e-9, "saved k = {k}, slider {k_high}")

@@ -6,9 +6,11 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use sillage_core::{Error, Result};
 
+use crate::bedload::detector::BeadDetectorConfig;
 use crate::toml_config::{parse_toml, read_toml_file, set_key};
 use sillage_detect::blob::BlobParams;
 use sillage_detect::preprocess::PreprocessParams;
+use sillage_track::bedload::BedloadTrackerParams;
 use sillage_track::ptv::PtvParams;
 
 /// Everything a run needs besides its input and output paths.
@@ -35,6 +37,9 @@ pub struct PipelineConfig {
 pub enum DetectorConfig {
     /// DoG/LoG blob detection with sub-pixel refinement (TracTrac §3.1.1).
     Blob(BlobParams),
+    /// The MMPF+ bead detector: black beads by threshold, transparent beads by ring
+    /// correlation, and the detector-confidence candidates of Eq. (1) (MMPF+ §3.3).
+    Bead(BeadDetectorConfig),
 }
 
 impl Default for DetectorConfig {
@@ -49,6 +54,9 @@ impl Default for DetectorConfig {
 pub enum TrackerConfig {
     /// TracTrac-class three-frame PTV with a local-flow predictor (TracTrac §3.1.2-3.1.4).
     Ptv(PtvParams),
+    /// The bedload trackers of the MMPF+ paper's Table 1 (MMPF+ and its baselines), over
+    /// detections with bead classes and the candidates of Eq. (1).
+    Bedload(BedloadTrackerParams),
 }
 
 impl Default for TrackerConfig {
@@ -132,9 +140,21 @@ impl PipelineConfig {
         self.preprocess.validate()?;
         match &self.detector {
             DetectorConfig::Blob(params) => params.validate()?,
+            DetectorConfig::Bead(bead) => bead.params.validate()?,
         }
         match &self.tracker {
             TrackerConfig::Ptv(params) => params.validate()?,
+            TrackerConfig::Bedload(params) => {
+                params.validate()?;
+                if self.training_passes > 0 {
+                    return Err(Error::parameter(
+                        "training_passes",
+                        self.training_passes,
+                        "training passes train PTV's motion model; set it to 0 for the bedload \
+                         tracker",
+                    ));
+                }
+            }
         }
         if self.training_passes > MAX_TRAINING_PASSES {
             return Err(Error::parameter(
@@ -153,8 +173,10 @@ mod tests {
     use sillage_detect::Threshold;
 
     fn blob(config: &PipelineConfig) -> &BlobParams {
-        let DetectorConfig::Blob(params) = &config.detector;
-        params
+        match &config.detector {
+            DetectorConfig::Blob(params) => params,
+            other => panic!("not the blob detector: {other:?}"),
+        }
     }
 
     #[test]
@@ -166,7 +188,9 @@ mod tests {
         config.set("detector.subpixel=quadratic").unwrap();
         assert_eq!(blob(&config).scale_px, 3.5);
         assert_eq!(blob(&config).threshold, Threshold::Fixed(0.015));
-        let TrackerConfig::Ptv(ptv) = &config.tracker;
+        let TrackerConfig::Ptv(ptv) = &config.tracker else {
+            panic!("not PTV: {:?}", config.tracker);
+        };
         assert_eq!(ptv.motion_av, 4);
         config.set("detector.threshold.auto.std_factor=2").unwrap();
         assert_eq!(blob(&config).threshold, Threshold::Auto { std_factor: 2.0 });
@@ -206,5 +230,28 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("motion_avg"), "{err}");
+    }
+
+    #[test]
+    fn bead_detector_and_bedload_tracker_round_trip_through_toml() {
+        let mut config = PipelineConfig::default();
+        config.set("detector.kind=bead").unwrap();
+        config
+            .set("detector.params.transparent_threshold=0.3")
+            .unwrap();
+        config.set("tracker.kind=bedload").unwrap();
+        config.set("tracker.likelihood.gamma=0.7").unwrap();
+        let DetectorConfig::Bead(bead) = &config.detector else {
+            panic!("not the bead detector: {:?}", config.detector);
+        };
+        assert_eq!(bead.params.transparent_threshold, 0.3);
+        config.validate().unwrap();
+        let text = config.to_toml_string().unwrap();
+        assert_eq!(PipelineConfig::from_toml_str(&text).unwrap(), config);
+        config
+            .set("detector.params.transparent_threshold=2")
+            .unwrap();
+        let err = config.validate().unwrap_err().to_string();
+        assert!(err.contains("transparent_threshold"), "{err}");
     }
 }

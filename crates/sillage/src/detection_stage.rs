@@ -6,14 +6,18 @@
 use sillage_core::{Detection, Detector, Error, GrayImage, Result};
 use sillage_detect::blob::BlobDetector;
 use sillage_detect::preprocess::Preprocessor;
+use sillage_detect::{BeadDetections, BeadDetector};
 use sillage_io::Frame;
 
+use crate::bedload::detector::detect_frame;
 use crate::config::{DetectorConfig, PipelineConfig};
 
 /// The built-in detectors, chosen by [`DetectorConfig`].
 #[derive(Debug, Clone)]
 enum AnyDetector {
     Blob(BlobDetector),
+    /// The bead detector and the beads of the last frame (their candidates are kept).
+    Bead(Box<(BeadDetector, BeadDetections)>),
 }
 
 /// The pre-processor, mask and detector of a [`PipelineConfig`], fed one frame at a time.
@@ -38,6 +42,9 @@ impl DetectionStage {
             .transpose()?;
         let detector = match &config.detector {
             DetectorConfig::Blob(params) => AnyDetector::Blob(BlobDetector::new(*params)?),
+            DetectorConfig::Bead(bead) => {
+                AnyDetector::Bead(Box::new((bead.build()?, BeadDetections::default())))
+            }
         };
         Ok(Self {
             preprocessor: Preprocessor::new(config.preprocess)?,
@@ -86,14 +93,24 @@ impl DetectionStage {
                 ),
             ));
         }
-        let AnyDetector::Blob(detector) = &mut self.detector;
-        if self.preprocessing {
+        let image = if self.preprocessing {
             self.preprocessor
                 .process(&frame.image, self.mask.as_ref(), &mut self.preprocessed)?;
-            detector.detect(&self.preprocessed, out)
+            &self.preprocessed
         } else {
             // Nothing to do before detection: no copy of the frame.
-            detector.detect(&frame.image, out)
+            &frame.image
+        };
+        match &mut self.detector {
+            AnyDetector::Blob(detector) => detector.detect(image, out),
+            AnyDetector::Bead(bead) => {
+                let (detector, beads) = &mut **bead;
+                detect_frame(detector, frame, image, beads)?;
+                out.clear();
+                out.extend_from_slice(&beads.black);
+                out.extend_from_slice(&beads.transparent);
+                Ok(())
+            }
         }
     }
 
@@ -107,15 +124,29 @@ impl DetectionStage {
         }
     }
 
-    /// The band-passed image of the last frame (the detector's ROI), for threshold displays.
-    pub fn filtered(&self) -> &GrayImage {
-        let AnyDetector::Blob(detector) = &self.detector;
-        detector.filtered()
+    /// The detector-confidence candidates of Eq. (1) of the MMPF+ paper found in the last
+    /// frame (empty for detectors that make none).
+    pub fn candidates(&self) -> &[Detection] {
+        match &self.detector {
+            AnyDetector::Blob(_) => &[],
+            AnyDetector::Bead(bead) => &bead.1.candidates,
+        }
+    }
+
+    /// The band-passed image of the last frame (the detector's ROI), for threshold displays;
+    /// `None` for detectors without one (the bead detector).
+    pub fn filtered(&self) -> Option<&GrayImage> {
+        match &self.detector {
+            AnyDetector::Blob(detector) => Some(detector.filtered()),
+            AnyDetector::Bead(_) => None,
+        }
     }
 
     /// The intensity threshold applied to [`DetectionStage::filtered`] on the last frame.
     pub fn last_threshold(&self) -> Option<f32> {
-        let AnyDetector::Blob(detector) = &self.detector;
-        detector.last_threshold()
+        match &self.detector {
+            AnyDetector::Blob(detector) => detector.last_threshold(),
+            AnyDetector::Bead(_) => None,
+        }
     }
 }

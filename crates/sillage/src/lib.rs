@@ -41,7 +41,7 @@ pub mod vortex_files;
 
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
 pub use detection_stage::DetectionStage;
-pub use pipeline::{FrameInput, FrameReport, Pipeline, RunSummary};
+pub use pipeline::{FrameInput, FrameObserver, FrameReport, Pipeline, RunSummary};
 
 pub use sillage_assoc as assoc;
 pub use sillage_core as core;

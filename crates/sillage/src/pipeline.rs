@@ -7,6 +7,7 @@ use sillage_core::{
     Tracker,
 };
 use sillage_io::Frame;
+use sillage_track::bedload::{BedloadStats, BedloadTracker};
 use sillage_track::ptv::{PassDirection, PtvTracker};
 
 use crate::config::{PipelineConfig, TrackerConfig};
@@ -15,18 +16,23 @@ use crate::detection_stage::DetectionStage;
 /// The built-in trackers, chosen by [`TrackerConfig`].
 enum AnyTracker {
     Ptv(PtvTracker),
+    Bedload(Box<BedloadTracker>),
 }
 
 impl AnyTracker {
     fn as_tracker(&mut self) -> &mut dyn Tracker {
         match self {
             AnyTracker::Ptv(t) => t,
+            AnyTracker::Bedload(t) => t.as_mut(),
         }
     }
 
+    /// Starts a training pass; only PTV trains (the configuration refuses training passes
+    /// for the others).
     fn start_pass(&mut self, direction: PassDirection) {
         match self {
             AnyTracker::Ptv(t) => t.start_pass(direction),
+            AnyTracker::Bedload(_) => {}
         }
     }
 }
@@ -43,6 +49,9 @@ pub enum FrameInput {
         frame: FrameIndex,
         /// Its detections.
         detections: Vec<Detection>,
+        /// Its detector-confidence candidates (Eq. (1) of the MMPF+ paper), empty when the
+        /// detector made none.
+        candidates: Vec<Detection>,
     },
 }
 
@@ -63,6 +72,8 @@ pub struct FrameReport {
     pub frame: FrameIndex,
     /// Objects detected in it.
     pub detections: usize,
+    /// Detector-confidence candidates shown to the tracker with them.
+    pub candidates: usize,
     /// Track points emitted while processing it (points of earlier frames that became final).
     pub points_emitted: usize,
     /// Wall time of pre-processing and detection.
@@ -94,7 +105,14 @@ pub struct Pipeline {
     tracker: AnyTracker,
     training_passes: usize,
     detections: Vec<Detection>,
+    /// The candidates of a frame given as detections ([`FrameInput::Detections`]); those of
+    /// a detected frame stay in the detection stage.
+    candidates: Vec<Detection>,
 }
+
+/// What [`Pipeline::run_inputs`] shows its caller after each frame: the frame's report and
+/// what the tracker saw.
+pub type FrameObserver<'a> = dyn FnMut(&FrameReport, &FrameObservations<'_>) + 'a;
 
 /// Counts what passes through to the real sink, so the run summary needs no second look.
 struct CountingSink<'a> {
@@ -135,13 +153,26 @@ impl Pipeline {
         config.validate()?;
         let tracker = match &config.tracker {
             TrackerConfig::Ptv(params) => AnyTracker::Ptv(PtvTracker::new(params.clone())?),
+            TrackerConfig::Bedload(params) => {
+                AnyTracker::Bedload(Box::new(BedloadTracker::new(params)?))
+            }
         };
         Ok(Self {
             stage: DetectionStage::from_config(config)?,
             tracker,
             training_passes: config.training_passes,
             detections: Vec::new(),
+            candidates: Vec::new(),
         })
+    }
+
+    /// The bedload tracker's counts so far (frames, confirmed tracks, predictions through
+    /// misses); `None` for the other trackers.
+    pub fn bedload_stats(&self) -> Option<BedloadStats> {
+        match &self.tracker {
+            AnyTracker::Bedload(tracker) => Some(tracker.stats()),
+            AnyTracker::Ptv(_) => None,
+        }
     }
 
     /// How many leading frames [`Pipeline::prime_background`] wants (0 without background
@@ -182,12 +213,18 @@ impl Pipeline {
         Ok(&self.detections)
     }
 
-    /// Fills `self.detections` from `input`: detected in its image, or copied from it.
+    /// Fills `self.detections` from `input`: detected in its image, or copied from it with
+    /// its candidates.
     fn observe(&mut self, input: &FrameInput) -> Result<Duration> {
         match input {
             FrameInput::Image(frame) => self.detect(frame),
-            FrameInput::Detections { detections, .. } => {
+            FrameInput::Detections {
+                detections,
+                candidates,
+                ..
+            } => {
                 self.detections.clone_from(detections);
+                self.candidates.clone_from(candidates);
                 Ok(Duration::ZERO)
             }
         }
@@ -201,7 +238,11 @@ impl Pipeline {
         sink: &mut dyn TrackSink,
         on_frame: &mut dyn FnMut(&FrameReport),
     ) -> Result<RunSummary> {
-        self.run_inputs(frames.map(|f| f.map(FrameInput::Image)), sink, on_frame)
+        self.run_inputs(
+            frames.map(|f| f.map(FrameInput::Image)),
+            sink,
+            &mut |report, _| on_frame(report),
+        )
     }
 
     /// [`Pipeline::run`] on detections made elsewhere (a detections table): the configured
@@ -214,39 +255,50 @@ impl Pipeline {
         sink: &mut dyn TrackSink,
         on_frame: &mut dyn FnMut(&FrameReport),
     ) -> Result<RunSummary> {
-        let inputs = frames
-            .map(|f| f.map(|(frame, detections)| FrameInput::Detections { frame, detections }));
-        self.run_inputs(inputs, sink, on_frame)
+        let inputs = frames.map(|f| {
+            f.map(|(frame, detections)| FrameInput::Detections {
+                frame,
+                detections,
+                candidates: Vec::new(),
+            })
+        });
+        self.run_inputs(inputs, sink, &mut |report, _| on_frame(report))
     }
 
-    /// The shared body of [`Pipeline::run`] and [`Pipeline::run_detections`].
-    fn run_inputs(
+    /// The body of [`Pipeline::run`] and [`Pipeline::run_detections`], on frames of either
+    /// kind (detections with their candidates: the bedload trackers' tables). `on_frame` sees
+    /// each frame's report and the observations the tracker was given (overlays keep the
+    /// detections from there).
+    pub fn run_inputs(
         &mut self,
         inputs: impl Iterator<Item = Result<FrameInput>>,
         sink: &mut dyn TrackSink,
-        on_frame: &mut dyn FnMut(&FrameReport),
+        on_frame: &mut FrameObserver<'_>,
     ) -> Result<RunSummary> {
         let mut counting = CountingSink::new(sink);
         let mut totals = RunSummary::default();
         let (mut detect_time, mut track_time) = (Duration::ZERO, Duration::ZERO);
-        let mut add = |report: &FrameReport| {
+        let mut add = |report: &FrameReport, observations: &FrameObservations<'_>| {
             detect_time += report.detect_time;
             track_time += report.track_time;
             totals.frames += 1;
             totals.detections += report.detections as u64;
-            on_frame(report);
+            on_frame(report, observations);
         };
         if self.training_passes == 0 {
             for input in inputs {
-                add(&self.step_output_pass(&input?, &mut counting)?);
+                self.step_output_pass(&input?, &mut counting, &mut add)?;
             }
         } else {
             let cached = self.detect_all(inputs)?;
             self.train(&cached)?;
             self.tracker.start_pass(PassDirection::Forward);
+            // Training passes replay detections only: PTV, the tracker that trains, takes no
+            // candidates.
+            self.candidates.clear();
             for (index, detections, detect) in &cached {
                 self.detections.clone_from(detections);
-                add(&self.track(*index, None, *detect, &mut counting)?);
+                self.track(*index, None, *detect, &mut counting, &mut add)?;
             }
         }
         self.tracker.as_tracker().finish(&mut counting)?;
@@ -272,7 +324,7 @@ impl Pipeline {
                 "a streamed run has a single pass; set it to 0 or run the whole sequence at once",
             ));
         }
-        self.step_output_pass(input, &mut CountingSink::new(sink))
+        self.step_output_pass(input, &mut CountingSink::new(sink), &mut |_, _| {})
     }
 
     /// Flushes the points the tracker still holds at the end of a streamed run
@@ -286,41 +338,53 @@ impl Pipeline {
         &mut self,
         input: &FrameInput,
         sink: &mut CountingSink<'_>,
+        on_frame: &mut FrameObserver<'_>,
     ) -> Result<FrameReport> {
         let detect = self.observe(input)?;
         let frame = match input {
             FrameInput::Image(frame) => Some(frame),
             FrameInput::Detections { .. } => None,
         };
-        self.track(input.index(), frame, detect, sink)
+        self.track(input.index(), frame, detect, sink, on_frame)
     }
 
     /// Feeds `self.detections` of frame `index` to the tracker, with the image the detector saw
-    /// when `frame` is at hand (not in replayed training passes).
+    /// and its candidates when `frame` is at hand (not in replayed training passes), else the
+    /// candidates given with the detections; then shows the report to `on_frame`.
     fn track(
         &mut self,
         index: FrameIndex,
         frame: Option<&Frame>,
         detect_time: Duration,
         sink: &mut CountingSink<'_>,
+        on_frame: &mut FrameObserver<'_>,
     ) -> Result<FrameReport> {
         let before = sink.points;
         let start = Instant::now();
-        let image = frame.map(|frame| self.stage.detector_input(frame));
+        let (image, candidates) = match frame {
+            Some(frame) => (
+                Some(self.stage.detector_input(frame)),
+                self.stage.candidates(),
+            ),
+            None => (None, self.candidates.as_slice()),
+        };
         let observations = FrameObservations {
             frame: index,
             detections: &self.detections,
             image,
-            candidates: &[],
+            candidates,
         };
         self.tracker.as_tracker().step(&observations, sink)?;
-        Ok(FrameReport {
+        let report = FrameReport {
             frame: index,
             detections: self.detections.len(),
+            candidates: candidates.len(),
             points_emitted: (sink.points - before) as usize,
             detect_time,
             track_time: start.elapsed(),
-        })
+        };
+        on_frame(&report, &observations);
+        Ok(report)
     }
 
     /// First (forward) pass of a trained run: detects every frame, keeps the detections and
@@ -367,5 +431,50 @@ impl Pipeline {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use sillage_core::{Point2, TRANSPARENT_BEAD_CLASS};
+    use sillage_track::bedload::BedloadTrackerParams;
+
+    use super::*;
+
+    /// Candidates given with the detections reach the tracker and the observer, frame by
+    /// frame; training passes are refused for the bedload tracker.
+    #[test]
+    fn detections_tables_carry_their_candidates_to_the_bedload_tracker() {
+        let config = PipelineConfig {
+            tracker: TrackerConfig::Bedload(BedloadTrackerParams::default()),
+            ..PipelineConfig::default()
+        };
+        let mut pipeline = Pipeline::from_config(&config).unwrap();
+        let bead = |x: f64| Detection::of_class(Point2::new(x, 50.0), 0.5, TRANSPARENT_BEAD_CLASS);
+        let inputs = (0..4).map(|frame| {
+            Ok(FrameInput::Detections {
+                frame,
+                detections: vec![bead(100.0 + 4.0 * frame as f64)],
+                candidates: vec![bead(100.0 + 4.0 * frame as f64); frame as usize],
+            })
+        });
+        let mut seen = Vec::new();
+        let mut points: Vec<TrackPoint> = Vec::new();
+        let summary = pipeline
+            .run_inputs(inputs, &mut points, &mut |report, observations| {
+                assert_eq!(report.candidates, observations.candidates.len());
+                seen.push(report.candidates);
+            })
+            .unwrap();
+        assert_eq!(seen, [0, 1, 2, 3]);
+        assert_eq!(summary.frames, 4);
+        assert_eq!(pipeline.bedload_stats().unwrap().tracks, 1);
+        assert_eq!(points.len(), 4);
+        let trained = PipelineConfig {
+            training_passes: 1,
+            ..config
+        };
+        let err = Pipeline::from_config(&trained).err().unwrap().to_string();
+        assert!(err.contains("training_passes"), "{err}");
     }
 }

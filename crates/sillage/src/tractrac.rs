@@ -97,7 +97,13 @@ pub fn apply_par(config: &mut PipelineConfig, par: &TractracPar) -> Result<()> {
         None => {}
     }
 
-    let DetectorConfig::Blob(blob) = &mut config.detector;
+    let DetectorConfig::Blob(blob) = &mut config.detector else {
+        return Err(Error::parameter(
+            "detector.kind",
+            "bead",
+            "a TracTrac parameter file sets the blob detector; set detector.kind = \"blob\"",
+        ));
+    };
     if let Some(v) = par.peak_conv {
         blob.filter = match v {
             0.0 => BlobFilter::None,
@@ -155,7 +161,13 @@ pub fn apply_par(config: &mut PipelineConfig, par: &TractracPar) -> Result<()> {
         blob.roi = Some(roi);
     }
 
-    let TrackerConfig::Ptv(ptv) = &mut config.tracker;
+    let TrackerConfig::Ptv(ptv) = &mut config.tracker else {
+        return Err(Error::parameter(
+            "tracker.kind",
+            "bedload",
+            "a TracTrac parameter file sets the PTV tracker; set tracker.kind = \"ptv\"",
+        ));
+    };
     if let Some(v) = par.motion {
         ptv.motion = flag("motion", v)?;
     }

@@ -1,6 +1,7 @@
 //! The papers' experiments as library calls: the tables of `sillage bench`, each score the
 //! median over seeded runs.
 
+pub mod bedload;
 pub mod immpf;
 pub mod sequences;
 pub mod siftpf;

@@ -227,8 +227,8 @@ impl TuneSession {
                 .map(|d| [round_centi(d.pos_px.x), round_centi(d.pos_px.y), d.strength])
                 .collect(),
             histogram: maxima_histogram(
-                stage.filtered(),
-                blob_params(&config).neighbourhood,
+                band_passed(&stage)?,
+                blob_params(&config)?.neighbourhood,
                 threshold,
             ),
             detect_ms,
@@ -241,7 +241,8 @@ impl TuneSession {
         let config = parse_config(config)?;
         let (stage, _, _) = self.run_stage(index, &config)?;
         let (width, height) = self.frames[index].image.dimensions();
-        let placed = place_in_frame(stage.filtered(), blob_params(&config).roi, width, height);
+        let filtered = band_passed(&stage)?;
+        let placed = place_in_frame(filtered, blob_params(&config)?.roi, width, height);
         Ok(Response::bytes("image/png", encode_png(&placed)?))
     }
 
@@ -284,13 +285,25 @@ fn parse_config(value: serde_json::Value) -> Result<PipelineConfig> {
     let config: PipelineConfig = serde_json::from_value(value)
         .map_err(|e| Error::input(format!("the configuration does not parse: {e}")))?;
     config.validate()?;
+    blob_params(&config)?;
     Ok(config)
 }
 
-/// The blob detector's parameters of `config`.
-fn blob_params(config: &PipelineConfig) -> &BlobParams {
-    let DetectorConfig::Blob(params) = &config.detector;
-    params
+/// The blob detector's parameters of `config`, the one detector `sillage tune` tunes.
+fn blob_params(config: &PipelineConfig) -> Result<&BlobParams> {
+    match &config.detector {
+        DetectorConfig::Blob(params) => Ok(params),
+        _ => Err(Error::input(
+            "`sillage tune` tunes the blob detector; set detector.kind = \"blob\"",
+        )),
+    }
+}
+
+/// The band-passed image the blob detector thresholded in the last frame of `stage`.
+fn band_passed(stage: &DetectionStage) -> Result<&GrayImage> {
+    stage
+        .filtered()
+        .ok_or_else(|| Error::input("no band-passed image: `sillage tune` tunes the blob detector"))
 }
 
 /// `filtered`, the band-passed image of `roi` (the whole frame when `None`), placed in a

@@ -1,15 +1,17 @@
-//! The figures of `sillage bench bedload --plots DIR`: the MMPF+ paper's Fig. 6 (per
+//! The figures of the bedload evaluation (`sillage bench bedload --plots DIR`): the MMPF+
+//! paper's Fig. 6 (per
 //! sequence, correct tracks of transparent beads as bars and MOTA as curves, against τ_t) and
 //! Fig. 7 (per sequence, the motion-state F-scores of MMPF+ and MMPF), as PNG and SVG.
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
-use sillage::io::{write_png_rgb, write_text};
-use sillage::track::bedload::BedloadTrackerKind;
-use sillage::viz::{Figure, GroupedChart, Plot, Series, ValueAxis};
+use sillage_core::Result;
+use sillage_io::{write_png_rgb, write_text};
+use sillage_track::bedload::BedloadTrackerKind;
+use sillage_viz::{Figure, GroupedChart, Plot, Series, ValueAxis};
 
-use crate::bench_bedload::{Row, Scope, TABLE_THRESHOLD};
+use super::{Row, Scope, TABLE_THRESHOLD};
+use crate::bedload::create_folder;
 
 /// Size of one panel, px.
 const PANEL: (u32, u32) = (760, 460);
@@ -145,8 +147,7 @@ fn fig7(rows: &[Row]) -> Figure {
 
 /// Draws both figures into `dir` (created when missing); returns the files written.
 pub fn write_figures(dir: &Path, rows: &[Row]) -> Result<Vec<String>> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    create_folder(dir)?;
     let mut written = Vec::new();
     for (name, figure) in [
         ("fig6_tau_sweep", fig6(rows)),
