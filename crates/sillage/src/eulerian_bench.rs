@@ -116,3 +116,22 @@ fn write_table(path: &Path, format: TrackFormat, rows: u64) -> Result<()> {
     writer.finish()?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_generated_table_is_binned_then_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut rows_binned = 0;
+        let row = bench_eulerian_case(dir.path(), TrackFormat::Csv, 2500, &mut || rows_binned += 1)
+            .unwrap();
+        assert_eq!(
+            (row.rows, rows_binned, row.format.as_str()),
+            (2500, 2500, "csv")
+        );
+        assert!(row.bins > 0 && row.file_mib > 0.0, "{row:?}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+}

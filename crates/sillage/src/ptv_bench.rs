@@ -115,3 +115,22 @@ pub fn stream_memory(
     )?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_small_case_is_timed_and_a_stream_is_sampled_every_tenth() {
+        let row = bench_ptv_case(128, 50, 2).unwrap();
+        assert_eq!((row.size_px, row.particles, row.frames_timed), (128, 50, 2));
+        assert!(row.detections_per_frame > 0.0, "{row:?}");
+        assert!(
+            (row.total_ms_per_frame - row.detect_ms_per_frame - row.track_ms_per_frame).abs()
+                < 1e-9
+        );
+        let mut samples = Vec::new();
+        stream_memory(128, 50, 20, &mut |done, _| samples.push(done)).unwrap();
+        assert_eq!(samples, (1..=10).map(|i| 2 * i).collect::<Vec<_>>());
+    }
+}
