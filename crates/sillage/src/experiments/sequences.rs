@@ -135,3 +135,27 @@ pub fn sequence_frames(folder: &Path) -> Result<String> {
         ))),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sillage_eval::mot::TruthRole;
+
+    #[test]
+    fn the_truth_of_a_folder_keeps_every_box_and_skips_flag_0() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("gt")).unwrap();
+        std::fs::write(
+            dir.path().join("gt").join("gt.txt"),
+            "1,1,10,20,30,60,1,-1,-1,-1\n2,1,12,20,30,60,0,-1,-1,-1\n",
+        )
+        .unwrap();
+        std::fs::write(dir.path().join("seqinfo.ini"), "[Sequence]\nseqLength=5\n").unwrap();
+        let truth = SequenceTruth::load(dir.path()).unwrap();
+        assert_eq!(truth.frame_count, Some(5));
+        let roles: Vec<TruthRole> = truth.truth.iter().map(|t| t.role).collect();
+        assert_eq!(roles, [TruthRole::Scored, TruthRole::Skipped]);
+        assert_eq!(truth.truth[1].frame, 1);
+        assert_eq!(sequence_name(dir.path().join("PETS").as_path()), "PETS");
+    }
+}

@@ -218,5 +218,24 @@ mod tests {
         assert_eq!(params.min_blob_px, 150);
         let err = ImmpfSettings::load(None, &["motion_detector.typo=1".into()], None).unwrap_err();
         assert!(err.to_string().contains("typo"), "{err}");
+        // A file's unknown key reads as the detector's own table would.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.toml");
+        std::fs::write(
+            &path,
+            "[motion_detector]
+typo = 1
+",
+        )
+        .unwrap();
+        let err = ImmpfSettings::load(Some(&path), &[], None)
+            .unwrap_err()
+            .to_string();
+        let direct = crate::toml_config::parse_toml::<MotionParams>("typo = 1")
+            .unwrap_err()
+            .to_string();
+        let unknown = direct.split(';').next().unwrap();
+        assert!(err.contains(unknown), "{err} / {direct}");
+        assert!(!err.contains("TOML parse error"), "{err}");
     }
 }
