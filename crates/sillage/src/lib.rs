@@ -34,6 +34,7 @@ pub mod process_memory;
 pub mod ptv_bench;
 pub mod ptv_run;
 pub mod toml_config;
+pub mod tracking;
 pub mod tractrac;
 pub mod tune;
 pub mod viewer;
@@ -42,6 +43,7 @@ pub mod vortex_files;
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
 pub use detection_stage::DetectionStage;
 pub use pipeline::{FrameInput, FrameObserver, FrameReport, Pipeline, RunSummary};
+pub use tracking::{Detecting, Tracking, detect_source, track_source};
 
 pub use sillage_assoc as assoc;
 pub use sillage_core as core;
