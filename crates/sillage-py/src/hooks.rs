@@ -29,15 +29,21 @@ impl Between {
         frames: impl Iterator<Item = Result<T>> + 'a,
     ) -> impl Iterator<Item = Result<T>> + 'a {
         frames.map(move |frame| {
-            let signals = Python::attach(|py| py.check_signals());
-            if let Err(e) = signals {
-                self.keep(e);
-            }
-            if self.error.borrow().is_some() {
-                return Err(Error::input("stopped from Python"));
-            }
+            self.check()?;
             frame
         })
+    }
+
+    /// An error as soon as Ctrl-C is pressed or a callback failed, to stop the run.
+    pub fn check(&self) -> Result<()> {
+        let signals = Python::attach(|py| py.check_signals());
+        if let Err(e) = signals {
+            self.keep(e);
+        }
+        if self.error.borrow().is_some() {
+            return Err(Error::input("stopped from Python"));
+        }
+        Ok(())
     }
 
     /// Advances the progress bar by one frame.

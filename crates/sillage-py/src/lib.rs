@@ -10,6 +10,7 @@ mod eval;
 mod frames;
 mod hooks;
 mod linking;
+mod sources;
 mod stream;
 mod synth;
 
@@ -168,7 +169,10 @@ fn kinematic_columns<'py, P>(
 
 /// The columns of track points: those of [`kinematic_columns`], then `ax`, `ay`
 /// (accelerations in px/frame², NaN where not estimated).
-fn track_columns<'py>(py: Python<'py>, points: &[TrackPoint]) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn track_columns<'py>(
+    py: Python<'py>,
+    points: &[TrackPoint],
+) -> PyResult<Bound<'py, PyDict>> {
     let columns = kinematic_columns(py, points, |p| {
         (p.frame, p.track_id, p.pos_px, p.vel_px_per_frame)
     })?;
@@ -221,6 +225,8 @@ fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<stream::PtvStream>()?;
     module.add_function(wrap_pyfunction!(eval::evaluate, module)?)?;
     module.add_function(wrap_pyfunction!(bedload::track_bedload, module)?)?;
+    module.add_function(wrap_pyfunction!(sources::track, module)?)?;
+    module.add_function(wrap_pyfunction!(sources::detect, module)?)?;
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -302,3 +302,68 @@ def test_synth_bedload_bad_keys_and_values_raise_value_errors_naming_the_key():
         sillage.synth_bedload(n_frames=2, detection={"position_sigma_px": -1.0})
     with pytest.raises(ValueError, match="parameter `transition_probabilities`"):
         sillage.synth_bedload(transition_probabilities=[[2.0, 0, 0], [0, 1, 0], [0, 0, 1]])
+
+
+DATA = pathlib.Path(__file__).resolve().parents[4] / "shared" / "data"
+BEADS = DATA / "bedload_beads_lafaye2018"
+PETS = DATA / "pets09_s2l1" / "img1"
+
+
+@pytest.mark.parametrize("tracker, source, keywords, frames", [
+    ("ptv", DATA / "trackpy_bulk_water" / "frames",
+     {"polarity": "dark", "scale_px": 4.0}, 6),
+    ("bedload", BEADS / "images",
+     {"sequence_params": BEADS / "sequence_param.txt", "mask": BEADS / "sequence_base_mask.tif"},
+     5),
+    ("immpf", PETS, {"models": ["cv", "ca"]}, 40),
+    ("siftpf", PETS, {}, 30),
+])
+def test_track_runs_every_tracker_on_real_frames_repeatably(tracker, source, keywords, frames):
+    tracks = sillage.track(source, tracker, max_frames=frames, seed=2, **keywords)
+    assert len(tracks) > 0 and tracks.particle.nunique() > 0
+    assert tracks.frame.between(0, frames - 1).all()
+    assert not tracks.duplicated(["particle", "frame"]).any()
+    assert np.isfinite(tracks[["x", "y"]].to_numpy()).all()
+    if tracker in ("immpf", "siftpf"):
+        boxes = tracks[["bb_left", "bb_top", "bb_width", "bb_height"]].to_numpy()
+        assert np.isfinite(boxes).all() and (boxes[:, 2:] > 0).all()
+        # The point of a person is the foot of the box.
+        foot_y = tracks.bb_top + tracks.bb_height
+        assert np.allclose(tracks.y, foot_y)
+    if tracker == "bedload":
+        assert set(tracks.state) <= {"resting", "rolling", "saltating", "unknown"}
+        assert set(tracks["class"]) <= {0, 1}
+    again = sillage.track(source, tracker, max_frames=frames, seed=2, **keywords)
+    pd.testing.assert_frame_equal(tracks, again)
+
+
+@pytest.mark.parametrize("detector, source, keywords", [
+    ("blob", DATA / "trackpy_bulk_water" / "frames", {"polarity": "dark", "scale_px": 4.0}),
+    ("bead", BEADS / "images",
+     {"sequence_params": BEADS / "sequence_param.txt", "mask": BEADS / "sequence_base_mask.tif"}),
+    ("motion", PETS, {"min_blob_px": 200}),
+])
+def test_detect_runs_every_detector_on_real_frames(detector, source, keywords):
+    found = sillage.detect(source, detector, max_frames=8, **keywords)
+    assert len(found) > 0 and found.frame.between(0, 7).all()
+    assert np.isfinite(found[["x", "y", "signal"]].to_numpy()).all()
+    if detector == "motion":
+        boxes = found[["bb_left", "bb_top", "bb_width", "bb_height"]].to_numpy()
+        assert (boxes[:, 2] * boxes[:, 3] >= found.signal).all()
+        inside = ((found.x >= found.bb_left) & (found.x <= found.bb_left + found.bb_width))
+        assert inside.all()
+    if detector == "bead":
+        assert set(found["class"]) == {0, 1}
+
+
+def test_track_and_detect_refuse_unknown_names_and_keys_with_value_errors():
+    with pytest.raises(ValueError, match="unknown tracker `kalman`"):
+        sillage.track(PETS, "kalman")
+    with pytest.raises(ValueError, match="unknown detector `sift`"):
+        sillage.detect(PETS, "sift")
+    with pytest.raises(ValueError, match="tracker.particle_count"):
+        sillage.track(PETS, "immpf", particle_count=3, max_frames=2)
+    with pytest.raises(ValueError, match="min_blob_pixels"):
+        sillage.detect(PETS, "motion", min_blob_pixels=3, max_frames=2)
+    with pytest.raises(FileNotFoundError):
+        sillage.track(PETS, "siftpf", ground_plane=PETS / "missing.toml", max_frames=2)

@@ -23,7 +23,7 @@ An unknown key or a bad value raises ``ValueError`` naming the key.
 Example (the README's)::
 
     >>> import sillage, trackpy
-    >>> frames, truth = sillage.synth_vortex(particles=500, frames=8, seed=1)
+    >>> frames, truth = sillage.synth_vortex(n_particles=500, n_frames=8, seed=1)
     >>> tracks = sillage.ptv(frames, scale_px=2.0)
     >>> msd = trackpy.emsd(trackpy.filter_stubs(tracks, 3), mpp=1.0, fps=1.0)
 """
@@ -42,13 +42,28 @@ from . import _sillage
 
 __version__ = _sillage.__version__
 
-__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "track_bedload", "evaluate", "synth_vortex",
-           "synth_bedload", "config_keys"]
+__all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "track", "detect", "track_bedload",
+           "evaluate", "synth_vortex", "synth_bedload", "config_keys"]
 
 #: Column order of detections (trackpy's ``locate`` puts ``y`` before ``x``).
 _DETECTION_COLUMNS = ["y", "x", "signal", "frame"]
 #: Column order of trajectories.
 _TRACK_COLUMNS = ["y", "x", "frame", "particle", "vx", "vy", "ax", "ay"]
+#: Box columns of pedestrians and motion blobs, MOTChallenge's names (px).
+_BOX_COLUMNS = ["bb_left", "bb_top", "bb_width", "bb_height"]
+#: The columns :func:`track` returns for each tracker.
+_TRACKER_COLUMNS = {
+    "ptv": _TRACK_COLUMNS,
+    "bedload": _TRACK_COLUMNS + ["state", "class"],
+    "immpf": ["y", "x", "frame", "particle", "vx", "vy"] + _BOX_COLUMNS,
+    "siftpf": ["y", "x", "frame", "particle"] + _BOX_COLUMNS,
+}
+#: The columns :func:`detect` returns for each detector.
+_DETECTOR_COLUMNS = {
+    "blob": _DETECTION_COLUMNS,
+    "bead": _DETECTION_COLUMNS + ["class"],
+    "motion": _DETECTION_COLUMNS + _BOX_COLUMNS,
+}
 
 
 def config_keys() -> list[str]:
@@ -186,6 +201,97 @@ def link(features: pd.DataFrame, *, params: Mapping[str, Any] | None = None,
     # `assign` adds the three columns in one go: 10× cheaper than a copy then three
     # insertions on 200,000 rows (0.04 against 0.46 ms per frame of 20,000).
     return features.assign(**columns)
+
+
+def track(source: str | Any, tracker: str = "ptv", *, seed: int = 1,
+          sequence_params: str | Any | None = None, mask: str | Any | None = None,
+          ground_plane: str | Any | None = None, motion_prior: str | Any | None = None,
+          detections: str | Any | None = None, max_frames: int | None = None,
+          params: Mapping[str, Any] | None = None, progress: bool = False,
+          **keywords: Any) -> pd.DataFrame:
+    """Tracks the frames of ``source`` with any of sillage's four trackers.
+
+    ``source`` is a path: a folder of images, a glob pattern (``"run/*.tif"``), a multi-page
+    TIFF or a video (colour frames for the pedestrian trackers). ``tracker`` is
+
+    * ``"ptv"``: TracTrac's particle tracking (as :func:`ptv`);
+    * ``"bedload"``: the MMPF+ bead tracker on the bead detector's output, with motion
+      states; give the bead sizes with ``sequence_params`` (BeadTracking's
+      ``sequence_param.txt``) and the flume base with ``mask``;
+    * ``"immpf"``: pedestrians, one IMM particle filter each (motion blobs, or the
+      MOTChallenge ``detections`` file, as births); ``ground_plane`` (from
+      ``sillage fit homography``) sizes the boxes, ``motion_prior`` feeds the MP model;
+    * ``"siftpf"``: surveillance objects followed by their SIFT features' particle filters.
+
+    Keywords are keys of that tracker's configuration (``sillage config`` for PTV and the
+    bedload pipeline, ``sillage track immpf|siftpf --help``): a bare name is a key of the
+    ``tracker`` section (for PTV, of the one section holding it), ``section__key`` any key,
+    ``params`` dotted keys. ``seed`` seeds the particle filters.
+
+    Returns one row per track point: ``y``, ``x`` (px; for pedestrians the box's foot point),
+    ``frame``, ``particle``, then per tracker the velocities ``vx``, ``vy`` (px/frame),
+    accelerations ``ax``, ``ay``, ``state`` and ``class`` (bedload) or the box
+    ``bb_left``, ``bb_top``, ``bb_width``, ``bb_height`` (pedestrians).
+
+    >>> people = sillage.track("PETS09-S2L1/img1", "immpf", ground_plane="ground.toml",
+    ...                        models=["cv", "ca"], seed=1)
+    >>> people.groupby("particle").size()
+    """
+    if tracker not in _TRACKER_COLUMNS:
+        raise ValueError(f"unknown tracker `{tracker}`; choose one of {sorted(_TRACKER_COLUMNS)}")
+    section = None if tracker == "ptv" else "tracker"
+    overrides = _overrides(keywords, params, section)
+    with _progress(progress, max_frames, tracker) as update:
+        columns = _sillage.track(_path(source), tracker, overrides, int(seed),
+                                 _optional_path(sequence_params), _optional_path(mask),
+                                 _optional_path(ground_plane), _optional_path(motion_prior),
+                                 _optional_path(detections), max_frames, update)
+    return pd.DataFrame(columns)[_TRACKER_COLUMNS[tracker]]
+
+
+def detect(source: str | Any, detector: str = "blob", *,
+           sequence_params: str | Any | None = None, mask: str | Any | None = None,
+           max_frames: int | None = None, params: Mapping[str, Any] | None = None,
+           progress: bool = False, **keywords: Any) -> pd.DataFrame:
+    """Detects objects in the frames of ``source`` (a path, as for :func:`track`).
+
+    ``detector`` is ``"blob"`` (PTV's DoG/LoG blobs, as :func:`batch`), ``"bead"`` (the MMPF+
+    black and transparent beads; ``sequence_params`` and ``mask`` as for :func:`track`) or
+    ``"motion"`` (moving blobs over a Gaussian-mixture background, the pedestrian trackers'
+    births). Keywords are keys of the detector's configuration (``detector`` section for
+    blob and bead, the motion detector's own keys for motion), ``params`` dotted keys.
+
+    Returns one row per detection: ``y``, ``x`` (px), ``signal`` (the detector's response;
+    for motion blobs their area, px²), ``frame``, then ``class`` for beads (0 black,
+    1 transparent) and the box columns ``bb_left``, ``bb_top``, ``bb_width``, ``bb_height``
+    for motion blobs.
+
+    >>> blobs = sillage.detect("PETS09-S2L1/img1", "motion", max_frames=50)
+    """
+    if detector not in _DETECTOR_COLUMNS:
+        raise ValueError(
+            f"unknown detector `{detector}`; choose one of {sorted(_DETECTOR_COLUMNS)}")
+    section = "" if detector == "motion" else "detector"
+    overrides = _overrides(keywords, params, section)
+    with _progress(progress, max_frames, detector) as update:
+        columns = _sillage.detect(_path(source), detector, overrides,
+                                  _optional_path(sequence_params), _optional_path(mask),
+                                  max_frames, update)
+    return pd.DataFrame(columns)[_DETECTOR_COLUMNS[detector]]
+
+
+def _path(source: Any) -> str:
+    """A path argument as text (``str`` or any ``os.PathLike``)."""
+    if hasattr(source, "__fspath__"):
+        return str(source.__fspath__())
+    if not isinstance(source, str):
+        raise TypeError(f"source must be a path (a str or a pathlib.Path), not "
+                        f"{type(source).__name__}")
+    return source
+
+
+def _optional_path(path: Any) -> str | None:
+    return None if path is None else _path(path)
 
 
 def track_bedload(detections: pd.DataFrame, *, candidates: pd.DataFrame | None = None,
@@ -331,12 +437,16 @@ def _frame_count(frames: Any) -> int:
 
 def _overrides(keywords: Mapping[str, Any], params: Mapping[str, Any] | None,
                section: str | None) -> list[str]:
-    """``key=value`` overrides with dotted keys, values written as TOML."""
+    """``key=value`` overrides with dotted keys, values written as TOML: a bare keyword is a
+    key of ``section`` (of the configuration's top level when ``section`` is empty; for
+    ``None``, of the one section of :func:`config_keys` holding it)."""
     assignments: list[str] = []
     keys = None
     for name, value in keywords.items():
         if "__" in name:
             dotted = name.replace("__", ".")
+        elif section == "":
+            dotted = name
         elif section is not None:
             dotted = f"{section}.{name}"
         else:

@@ -39,3 +39,25 @@ def track_bedload(
     overrides: list[str],
     candidates: Optional[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = None,
 ) -> Columns: ...
+def track(
+    source: str,
+    tracker: str,
+    overrides: list[str],
+    seed: int = 1,
+    sequence_params: Optional[str] = None,
+    mask: Optional[str] = None,
+    ground_plane: Optional[str] = None,
+    motion_prior: Optional[str] = None,
+    detections: Optional[str] = None,
+    max_frames: Optional[int] = None,
+    progress: Progress = None,
+) -> Columns: ...
+def detect(
+    source: str,
+    detector: str,
+    overrides: list[str],
+    sequence_params: Optional[str] = None,
+    mask: Optional[str] = None,
+    max_frames: Optional[int] = None,
+    progress: Progress = None,
+) -> Columns: ...
