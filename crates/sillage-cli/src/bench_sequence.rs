@@ -9,7 +9,7 @@ use sillage::eval::MotData;
 use sillage::eval::mot::{BoundingBox, MotChallengeProtocol, MotEstimate, MotTruth, Shape};
 
 use crate::cli::MatchRule;
-use crate::eval_inputs::load_truth;
+use sillage::evaluate::load_truth;
 
 /// Boxes match when their IoU is at least 0.5 (CLEAR MOT's usual rule, and the papers').
 const BOX_MATCH: MatchRule = MatchRule::Iou { threshold: 0.5 };

@@ -19,7 +19,6 @@ mod detect_motion;
 mod eulerian;
 mod eulerian_plots;
 mod eval;
-mod eval_inputs;
 mod eval_mot;
 mod fit;
 mod fit_pedestrian;

@@ -20,7 +20,9 @@
 pub mod bedload;
 pub mod config;
 pub mod detection_stage;
+pub mod evaluate;
 pub mod pipeline;
+pub mod tables;
 pub mod toml_config;
 pub mod tractrac;
 
