@@ -4,7 +4,8 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use sillage::eval::mot::{MotChallengeProtocol, MotConvention, Similarity};
+pub use sillage::eval::mot::MatchRule;
+use sillage::eval::mot::{MotChallengeProtocol, MotConvention};
 use sillage::filter::{FitOptions, MotionPriorParams};
 
 /// Follow many moving objects through image sequences (PTV, bedload beads, pedestrians).
@@ -537,104 +538,6 @@ pub struct EvalMotArgs {
     /// Write every frame's events (match, switch, miss, false positive) to this CSV.
     #[arg(long, value_name = "FILE.csv")]
     pub per_frame: Option<PathBuf>,
-}
-
-/// `--match`: how the similarity of a prediction and a true object is measured, and the
-/// least similarity of a match.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum MatchRule {
-    /// Box IoU at least `threshold`.
-    Iou {
-        /// Least IoU.
-        threshold: f64,
-    },
-    /// Centres at most `radius_px` apart.
-    Distance {
-        /// Largest distance, px.
-        radius_px: f64,
-    },
-    /// Disc IoU (beads) at least `threshold`.
-    Disc {
-        /// Least IoU.
-        threshold: f64,
-    },
-}
-
-impl MatchRule {
-    /// The similarity measure. `dist:R` is TrackEval's Euclidean similarity vanishing at
-    /// `2R`, so that the threshold 0.5 accepts exactly the centres within `R`.
-    pub fn similarity(self) -> Similarity {
-        match self {
-            MatchRule::Iou { .. } => Similarity::BoxIou,
-            MatchRule::Distance { radius_px } => Similarity::Distance {
-                zero_distance_px: 2.0 * radius_px,
-            },
-            MatchRule::Disc { .. } => Similarity::DiscIou,
-        }
-    }
-
-    /// The least similarity of a match.
-    pub fn threshold(self) -> f64 {
-        match self {
-            MatchRule::Iou { threshold } | MatchRule::Disc { threshold } => threshold,
-            MatchRule::Distance { .. } => 0.5,
-        }
-    }
-}
-
-impl std::fmt::Display for MatchRule {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            MatchRule::Iou { threshold } => write!(f, "iou:{threshold} (box IoU ≥ {threshold})"),
-            MatchRule::Distance { radius_px } => {
-                write!(f, "dist:{radius_px} (centres at most {radius_px} px apart)")
-            }
-            MatchRule::Disc { threshold } => {
-                write!(f, "disc:{threshold} (bead disc IoU ≥ {threshold})")
-            }
-        }
-    }
-}
-
-impl FromStr for MatchRule {
-    type Err = String;
-
-    /// Parses `iou[:T]`, `dist:R` or `disc[:T]`.
-    fn from_str(text: &str) -> Result<Self, String> {
-        let (kind, value) = match text.split_once(':') {
-            Some((kind, value)) => (kind, Some(value)),
-            None => (text, None),
-        };
-        let number = |value: &str, what: &str, valid: fn(f64) -> bool| {
-            value
-                .trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|&v| valid(v))
-                .ok_or_else(|| format!("`{value}` is not {what}"))
-        };
-        let threshold = |default: f64| match value {
-            Some(v) => number(v, "an IoU in (0, 1]", |t| t > 0.0 && t <= 1.0),
-            None => Ok(default),
-        };
-        match kind.trim().to_ascii_lowercase().as_str() {
-            "iou" => Ok(MatchRule::Iou {
-                threshold: threshold(0.5)?,
-            }),
-            "disc" => Ok(MatchRule::Disc {
-                threshold: threshold(0.43)?,
-            }),
-            "dist" => {
-                let value = value.ok_or("dist needs a distance in px, e.g. dist:5")?;
-                Ok(MatchRule::Distance {
-                    radius_px: number(value, "a distance > 0 (px)", |r| r.is_finite() && r > 0.0)?,
-                })
-            }
-            _ => Err(format!(
-                "`{text}` is not a matching rule; use iou[:T], dist:R or disc[:T]"
-            )),
-        }
-    }
 }
 
 /// `--protocol`.

@@ -15,7 +15,6 @@ mod detect;
 mod detect_motion;
 mod eulerian;
 mod eval;
-mod eval_inputs;
 mod eval_mot;
 mod fit;
 mod fit_pedestrian;

@@ -20,6 +20,7 @@
 //!   `gt.txt`, `det.txt`, results and `seqinfo.ini` (a file or a sequence folder), and
 //!   [`MotResultsWriter`] / [`write_mot_results`] for results;
 //! - [`MotEventsCsvWriter`] for the per-frame events of an evaluation;
+//! - [`detect_table_format`] tells a table's [`TableFormat`] from its extension and first line;
 //! - [`read_bead_csv`] / [`read_bead_sequence_params`] for bead ground truth with categories
 //!   and motion states (BeadTracking, the MMPF+ paper's code).
 //!
@@ -68,6 +69,7 @@ mod mot;
 mod mot_events;
 mod numeric_table;
 mod partial;
+mod table_format;
 mod text_table;
 mod tracks;
 mod tractrac_par;
@@ -94,6 +96,7 @@ pub use mot::{
 pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
 pub use numeric_table::{ColumnValues, NumericFormat, NumericTable, write_numeric_table};
 pub use partial::PartialFile;
+pub use table_format::{TableFormat, detect_table_format};
 pub use tracks::{
     STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackLayout,
     TrackTable, TrackWriter, WrittenSummary, create_track_writer, for_each_track_point,

@@ -37,6 +37,7 @@ mod data;
 mod hota;
 mod identity;
 pub(crate) mod ids;
+mod match_rule;
 mod params;
 mod similarity;
 
@@ -51,6 +52,7 @@ pub use data::{
 };
 pub use hota::{HOTA_ALPHA_COUNT, HotaCurves, HotaMetrics, PerAlpha, hota, hota_alphas};
 pub use identity::{IdentityMetrics, identity};
+pub use match_rule::MatchRule;
 pub use params::{MotConvention, MotParams};
 pub use similarity::{Shape, Similarity, box_iou, disc_iou, distance_similarity};
 
