@@ -1,88 +1,116 @@
-//! CLEAR MOT, IDF1 and HOTA of point tracks against their truth.
+//! CLEAR MOT, IDF1 and HOTA (and the papers' own scores) of tracks against their truth, for
+//! points, bead discs and boxes, scored by `sillage::evaluate::evaluate_rows` exactly as
+//! `sillage eval mot` scores files.
 
 use numpy::PyReadonlyArray1;
 use numpy::ndarray::ArrayView1;
 use pyo3::prelude::*;
-use sillage::core::{Error, Point2, Result};
-use sillage::eval::evaluate_mot;
-use sillage::eval::mot::{MotData, MotEstimate, MotParams, MotTruth, Shape, Similarity, TruthRole};
+use sillage::core::{BoundingBox, Error, Point2, Result};
+use sillage::eval::mot::{MatchRule, Shape};
+use sillage::evaluate::{EvalOptions, ObjectRow, evaluate_rows};
 
 use crate::errors::to_py;
 
-/// One table's columns: frame, id, x, y.
+/// One table's columns: frame, id, x, y, the box (`bb_left`, `bb_top`, `bb_width`,
+/// `bb_height`) and the disc radius, NaN where a table has none.
 type Columns<'py> = (
     PyReadonlyArray1<'py, i64>,
     PyReadonlyArray1<'py, i64>,
-    PyReadonlyArray1<'py, f64>,
-    PyReadonlyArray1<'py, f64>,
+    [PyReadonlyArray1<'py, f64>; 7],
 );
 
-/// Scores the estimated points against the true ones (TrackEval's conventions, points
-/// matched within `match_px`); returns the metrics as JSON (`clear`, `identity`, `hota`).
+/// Read-only views of a table's columns.
+struct Table<'a> {
+    frame: ArrayView1<'a, i64>,
+    id: ArrayView1<'a, i64>,
+    values: [ArrayView1<'a, f64>; 7],
+}
+
+impl<'a> Table<'a> {
+    fn of(columns: &'a Columns<'_>) -> Self {
+        Self {
+            frame: columns.0.as_array(),
+            id: columns.1.as_array(),
+            values: std::array::from_fn(|i| columns.2[i].as_array()),
+        }
+    }
+
+    /// The rows as the shapes `rule` compares; a row without the shape's values, or with a
+    /// negative frame or id, is an error naming the table, the row and the fix.
+    fn rows(&self, name: &str, rule: MatchRule) -> Result<Vec<ObjectRow>> {
+        (0..self.frame.len())
+            .map(|row| {
+                let (Ok(frame), Ok(id)) =
+                    (u64::try_from(self.frame[row]), u64::try_from(self.id[row]))
+                else {
+                    return Err(Error::input(format!(
+                        "{name} row {row}: frame {} and particle {} must be ≥ 0",
+                        self.frame[row], self.id[row]
+                    )));
+                };
+                let [x, y, left, top, width, height, radius] = self.values.map(|c| c[row]);
+                let missing = |what: &str| {
+                    Error::input(format!(
+                        "{name} row {row}: --match {rule} compares {what}; give them finite"
+                    ))
+                };
+                let shape = match rule {
+                    MatchRule::Distance { .. } => Shape::Point(Point2::new(x, y)),
+                    MatchRule::Iou { .. } => {
+                        if ![left, top, width, height].iter().all(|v| v.is_finite()) {
+                            return Err(missing("boxes (bb_left, bb_top, bb_width, bb_height)"));
+                        }
+                        Shape::Box(BoundingBox {
+                            left_px: left,
+                            top_px: top,
+                            width_px: width,
+                            height_px: height,
+                        })
+                    }
+                    MatchRule::Disc { .. } => {
+                        if !radius.is_finite() {
+                            return Err(missing("discs (a radius per row or per class)"));
+                        }
+                        Shape::Disc {
+                            centre_px: Point2::new(x, y),
+                            radius_px: radius,
+                        }
+                    }
+                };
+                Ok(ObjectRow { frame, id, shape })
+            })
+            .collect()
+    }
+}
+
+/// Scores `tracks` against `truth` under the match rule `rule` (`iou:0.5`, `disc:0.43`,
+/// `dist:1`), with the papers' scores when `papers`; returns the combined scores as JSON
+/// (`metrics` with `clear`, `identity`, `hota`; `papers` when asked).
 #[pyfunction]
+#[pyo3(signature = (truth, tracks, rule, papers=false))]
 pub fn evaluate(
     py: Python<'_>,
     truth: Columns<'_>,
     tracks: Columns<'_>,
-    match_px: f64,
+    rule: &str,
+    papers: bool,
 ) -> PyResult<String> {
-    let truth_views = (
-        truth.0.as_array(),
-        truth.1.as_array(),
-        truth.2.as_array(),
-        truth.3.as_array(),
-    );
-    let track_views = (
-        tracks.0.as_array(),
-        tracks.1.as_array(),
-        tracks.2.as_array(),
-        tracks.3.as_array(),
-    );
+    let rule: MatchRule = rule.parse().map_err(to_py)?;
+    let (truth, tracks) = (Table::of(&truth), Table::of(&tracks));
     py.detach(|| {
-        let truth = objects("truth", truth_views, |frame, id, centre| MotTruth {
-            frame,
-            id,
-            shape: Shape::Point(centre),
-            role: TruthRole::Scored,
-        })?;
-        let estimates = objects("tracks", track_views, |frame, id, centre| MotEstimate {
-            frame,
-            id,
-            shape: Shape::Point(centre),
-        })?;
-        let similarity = Similarity::Distance {
-            zero_distance_px: 2.0 * match_px,
+        let options = EvalOptions {
+            rule,
+            papers,
+            ..EvalOptions::default()
         };
-        let data = MotData::new(&truth, &estimates, similarity, None)
-            .map_err(|e| e.in_section("match_px"))?;
-        let metrics = evaluate_mot(&data, &MotParams::default())?;
-        serde_json::to_string(&metrics)
-            .map_err(|e| Error::input(format!("cannot write the metrics: {e}")))
+        let evaluation = evaluate_rows(
+            "python",
+            &truth.rows("truth", rule)?,
+            &tracks.rows("tracks", rule)?,
+            &options,
+        )?;
+        serde_json::to_string(&evaluation.combined)
+            .map_err(|e| Error::input(format!("cannot write the scores: {e}")))
     })
     .map_err(to_py)
-}
-
-/// The rows of one table as objects made by `make(frame, id, centre)`; negative frames or
-/// ids are errors naming the table and the row.
-fn objects<T>(
-    table: &str,
-    (frame, id, x, y): (
-        ArrayView1<'_, i64>,
-        ArrayView1<'_, i64>,
-        ArrayView1<'_, f64>,
-        ArrayView1<'_, f64>,
-    ),
-    make: impl Fn(u64, u64, Point2) -> T,
-) -> Result<Vec<T>> {
-    (0..frame.len())
-        .map(|row| {
-            let (Ok(f), Ok(i)) = (u64::try_from(frame[row]), u64::try_from(id[row])) else {
-                return Err(Error::input(format!(
-                    "{table} row {row}: frame {} and particle {} must be ≥ 0",
-                    frame[row], id[row]
-                )));
-            };
-            Ok(make(f, i, Point2::new(x[row], y[row])))
-        })
-        .collect()
 }

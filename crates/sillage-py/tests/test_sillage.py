@@ -367,3 +367,95 @@ def test_track_and_detect_refuse_unknown_names_and_keys_with_value_errors():
         sillage.detect(PETS, "motion", min_blob_pixels=3, max_frames=2)
     with pytest.raises(FileNotFoundError):
         sillage.track(PETS, "siftpf", ground_plane=PETS / "missing.toml", max_frames=2)
+
+
+#: The `sillage` binary `cargo test --workspace` builds (CI runs it before this package).
+CLI = pathlib.Path(__file__).resolve().parents[3] / "target" / "debug" / "sillage"
+
+
+def cli_scores(*args: str) -> dict:
+    """The combined scores of `sillage eval mot ARGS --json`."""
+    import json
+    import subprocess
+    if not CLI.exists():
+        subprocess.run(["cargo", "build", "-p", "sillage-cli"], check=True,
+                       cwd=CLI.parents[2])
+    run = subprocess.run([str(CLI), "eval", "mot", *args, "--json"], check=True,
+                         capture_output=True, text=True)
+    return json.loads(run.stdout)["combined"]["metrics"]
+
+
+def mot_table(path) -> pd.DataFrame:
+    """A MOTChallenge file as a DataFrame (0-based frames, boxes as written)."""
+    rows = pd.read_csv(path, header=None).iloc[:, :6]
+    rows.columns = ["frame", "particle", "bb_left", "bb_top", "bb_width", "bb_height"]
+    rows["frame"] -= 1
+    return rows
+
+
+def assert_same_scores(ours: dict, cli: dict) -> None:
+    for family in ("clear", "identity", "hota"):
+        for key, value in cli[family].items():
+            if isinstance(value, (int, float)):
+                assert ours[family][key] == pytest.approx(value, rel=1e-12, abs=1e-12), \
+                    (family, key)
+
+
+def test_evaluate_scores_boxes_as_the_command_line_does(tmp_path):
+    tracks = sillage.track(PETS, "immpf", max_frames=40, seed=1)
+    pred = tmp_path / "pred.txt"
+    rows = tracks.assign(frame=tracks.frame + 1, conf=1, x=-1, y=-1, z=-1)
+    rows[["frame", "particle", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "x", "y",
+          "z"]].to_csv(pred, header=False, index=False, float_format="%.17g")
+    truth_file = PETS.parent / "gt" / "gt.txt"
+    cli = cli_scores("--gt", str(truth_file), "--pred", str(pred), "--match", "iou:0.5")
+    ours = sillage.evaluate(mot_table(truth_file), mot_table(pred), match="iou:0.5")
+    assert 0 < ours["clear"]["mota"] < 1
+    assert_same_scores(ours, cli)
+
+
+def test_evaluate_scores_bead_discs_as_the_command_line_does(tmp_path):
+    pred = tmp_path / "beads.csv"
+    subprocess_args = ["track", "bedload", str(BEADS / "images"), "--sequence-params",
+                       str(BEADS / "sequence_param.txt"), "--mask",
+                       str(BEADS / "sequence_base_mask.tif"), "--out", str(pred)]
+    import subprocess
+    subprocess.run([str(CLI), *subprocess_args], check=True, capture_output=True)
+    truth_file = BEADS / "ground_truth" / "trackdatatruth.csv"
+    cli = cli_scores("--gt", str(truth_file), "--pred", str(pred), "--match", "disc:0.43")
+
+    def beads(path) -> pd.DataFrame:
+        return pd.read_csv(path).rename(columns={"id": "particle", "category": "class"})
+
+    ours = sillage.evaluate(beads(truth_file), beads(pred), match="disc:0.43",
+                            radius_px=[15, 10])
+    assert ours["clear"]["mota"] > 0.9
+    assert_same_scores(ours, cli)
+
+
+def test_evaluate_scores_points_as_the_command_line_does(tmp_path):
+    import subprocess
+    folder = tmp_path / "vortex"
+    subprocess.run([str(CLI), "synth", "vortex", "--out", str(folder), "--frames", "8",
+                    "--particles", "300", "--width", "256", "--height", "256"], check=True,
+                   capture_output=True)
+    tracks_file = tmp_path / "tracks.csv"
+    subprocess.run([str(CLI), "ptv", str(folder), "--out", str(tracks_file)], check=True,
+                   capture_output=True)
+    cli = cli_scores("--gt", str(folder / "truth.csv"), "--pred", str(tracks_file),
+                     "--match", "dist:1")
+    truth = pd.read_csv(folder / "truth.csv").rename(columns={"track_id": "particle"})
+    tracks = pd.read_csv(tracks_file)
+    ours = sillage.evaluate(truth, tracks, match="dist:1")
+    assert 0 < ours["clear"]["mota"] <= 1
+    assert_same_scores(ours, cli)
+
+
+def test_evaluate_names_what_a_rule_needs():
+    points = pd.DataFrame({"frame": [0], "particle": [1], "x": [1.0], "y": [2.0]})
+    with pytest.raises(ValueError, match="bb_left"):
+        sillage.evaluate(points, points, match="iou:0.5")
+    with pytest.raises(ValueError, match="radius"):
+        sillage.evaluate(points, points, match="disc:0.43")
+    with pytest.raises(ValueError, match="match"):
+        sillage.evaluate(points, points, match="cosine:1")

@@ -331,31 +331,77 @@ def track_bedload(detections: pd.DataFrame, *, candidates: pd.DataFrame | None =
     return pd.DataFrame(result)[_TRACK_COLUMNS + ["state", "class"]]
 
 
-def evaluate(truth: pd.DataFrame, tracks: pd.DataFrame, *, match_px: float = 1.0) -> dict:
-    """CLEAR MOT, IDF1 and HOTA of ``tracks`` against ``truth`` (TrackEval's conventions).
+def evaluate(truth: pd.DataFrame, tracks: pd.DataFrame, *, match: str | None = None,
+             match_px: float | None = None, radius_px: float | Iterable[float] | None = None,
+             papers: bool = False) -> dict:
+    """CLEAR MOT, IDF1 and HOTA of ``tracks`` against ``truth``, as ``sillage eval mot``
+    scores files (TrackEval's conventions).
 
-    Both tables have one row per point with ``frame``, ``particle``, ``x``, ``y`` (trackpy's
-    layout; the truth of :func:`synth_vortex`, the output of :func:`ptv` or ``trackpy.link``).
-    A track point matches a true one within ``match_px`` pixels. Returns
-    ``{"clear": {"mota", "motp", "id_switches", ...}, "identity": {"idf1", ...},
-    "hota": {"hota", "det_a", "ass_a", "loc_a", ...}}`` (HOTA averaged over the localisation
-    thresholds, and per threshold).
+    Both tables have one row per object and frame with ``frame`` and ``particle`` (trackpy's
+    layout), and what the rule ``match`` compares:
 
-    >>> scores = sillage.evaluate(truth, sillage.ptv(frames), match_px=1.0)
+    * ``"dist:R"`` (the default, R = ``match_px`` or 1): points ``x``, ``y`` (px) at most R
+      apart — particles, e.g. :func:`synth_vortex`'s truth and :func:`ptv`'s tracks;
+    * ``"iou[:T]"``: boxes ``bb_left``, ``bb_top``, ``bb_width``, ``bb_height`` with IoU at
+      least T (0.5) — pedestrians, e.g. :func:`track` with ``"immpf"``;
+    * ``"disc[:T]"``: discs at ``x``, ``y`` with IoU at least T (0.43, the MMPF+ paper's) —
+      beads; their radius is a ``radius`` column or ``radius_px``, one number or one per
+      ``class`` (``[15, 10]`` for the shared flume's black and transparent beads).
+
+    Returns ``{"clear": {"mota", "motp", "id_switches", ...}, "identity": {"idf1", ...},
+    "hota": {"hota", "det_a", "ass_a", ...}}`` (HOTA averaged over the localisation
+    thresholds, and per threshold), with ``"papers"`` (the papers' own scores: MMPF+ correct
+    tracks, VACE, ETISEO) when ``papers=True``: the ``combined`` scores of
+    ``sillage eval mot --json``.
+
+    >>> scores = sillage.evaluate(truth, sillage.ptv(frames), match="dist:1")
     >>> scores["clear"]["mota"], scores["identity"]["idf1"]
     """
-    def columns(table: pd.DataFrame, name: str) -> tuple[np.ndarray, ...]:
-        missing = [c for c in ("frame", "particle", "x", "y") if c not in table.columns]
+    if match is None:
+        match = f"dist:{1.0 if match_px is None else float(match_px)}"
+    elif match_px is not None:
+        raise ValueError("give match (e.g. match='dist:2') or match_px, not both")
+    rule = match.split(":", 1)[0].strip().lower()
+
+    def columns(table: pd.DataFrame, name: str) -> tuple[Any, ...]:
+        needed = {"iou": ["bb_left", "bb_top", "bb_width", "bb_height"]}.get(rule, ["x", "y"])
+        missing = [c for c in ["frame", "particle", *needed] if c not in table.columns]
         if missing:
-            raise ValueError(f"{name} lacks the column(s) {missing}; give frame, particle, x, y")
+            raise ValueError(f"{name} lacks the column(s) {missing} that match={match!r} "
+                             f"compares")
+        n = len(table)
+
+        def column(key: str) -> np.ndarray:
+            values = table[key] if key in table.columns else np.full(n, np.nan)
+            return np.ascontiguousarray(values, dtype=np.float64)
+
+        if rule == "disc" and "radius" not in table.columns:
+            if radius_px is None:
+                raise ValueError(f"{name}: match={match!r} compares discs; give a radius "
+                                 f"column or radius_px (one number, or one per class)")
+            radii = np.atleast_1d(np.asarray(radius_px, dtype=np.float64))
+            classes = (np.asarray(table["class"], dtype=np.int64) if "class" in table.columns
+                       else np.zeros(n, dtype=np.int64))
+            if radii.size == 1:
+                radius = np.full(n, radii[0])
+            elif classes.size and (classes.min() < 0 or classes.max() >= radii.size):
+                raise ValueError(f"{name}: a class outside 0..{radii.size - 1} has no radius "
+                                 f"in radius_px")
+            else:
+                radius = radii[classes]
+        else:
+            radius = column("radius")
         return (np.ascontiguousarray(table["frame"], dtype=np.int64),
                 np.ascontiguousarray(table["particle"], dtype=np.int64),
-                np.ascontiguousarray(table["x"], dtype=np.float64),
-                np.ascontiguousarray(table["y"], dtype=np.float64))
+                [column(k) for k in ("x", "y", "bb_left", "bb_top", "bb_width", "bb_height")]
+                + [np.ascontiguousarray(radius, dtype=np.float64)])
 
-    metrics = _sillage.evaluate(columns(truth, "truth"), columns(tracks, "tracks"),
-                                float(match_px))
-    return json.loads(metrics)
+    combined = json.loads(_sillage.evaluate(columns(truth, "truth"), columns(tracks, "tracks"),
+                                            match, bool(papers)))
+    scores = combined["metrics"]
+    if "papers" in combined:
+        scores["papers"] = combined["papers"]
+    return scores
 
 
 def synth_vortex(**params: Any) -> tuple[np.ndarray, pd.DataFrame]:
@@ -406,7 +452,7 @@ def synth_bedload(*, detection: Mapping[str, Any] | None = None,
     >>> truth, detections, candidates = sillage.synth_bedload(n_frames=50, seed=1,
     ...                                                       detection={"position_sigma_px": 1.0})
     >>> beads = sillage.track_bedload(detections, candidates=candidates, seed=1)
-    >>> sillage.evaluate(truth, beads, match_px=5.0)["clear"]["mota"]
+    >>> sillage.evaluate(truth, beads, match="dist:5")["clear"]["mota"]
     """
     scene_overrides: list[str] = []
     for name, value in scene.items():

@@ -30,9 +30,10 @@ class PtvStream:
     def finish(self) -> Columns: ...
 
 def evaluate(
-    truth: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-    tracks: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-    match_px: float,
+    truth: tuple[np.ndarray, np.ndarray, list[np.ndarray]],
+    tracks: tuple[np.ndarray, np.ndarray, list[np.ndarray]],
+    rule: str,
+    papers: bool = False,
 ) -> str: ...
 def track_bedload(
     detections: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
