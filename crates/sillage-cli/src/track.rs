@@ -93,7 +93,7 @@ fn output_kind(format: Option<BeadFormatArg>) -> Option<BeadTrackKind> {
 pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     let params = load_bedload_params(args)?;
     let mut config = PipelineConfig {
-        tracker: TrackerConfig::Bedload(params.clone()),
+        tracker: TrackerConfig::Bedload(Box::new(params.clone())),
         ..PipelineConfig::default()
     };
     let (total, inputs): Inputs = match (&args.input, &args.detections) {

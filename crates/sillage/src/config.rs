@@ -56,7 +56,7 @@ pub enum TrackerConfig {
     Ptv(PtvParams),
     /// The bedload trackers of the MMPF+ paper's Table 1 (MMPF+ and its baselines), over
     /// detections with bead classes and the candidates of Eq. (1).
-    Bedload(BedloadTrackerParams),
+    Bedload(Box<BedloadTrackerParams>),
 }
 
 impl Default for TrackerConfig {

@@ -15,9 +15,9 @@ use crate::config::{DetectorConfig, PipelineConfig};
 /// The built-in detectors, chosen by [`DetectorConfig`].
 #[derive(Debug, Clone)]
 enum AnyDetector {
-    Blob(BlobDetector),
+    Blob(Box<BlobDetector>),
     /// The bead detector and the beads of the last frame (their candidates are kept).
-    Bead(Box<(BeadDetector, BeadDetections)>),
+    Bead(Box<BeadDetector>, BeadDetections),
 }
 
 /// The pre-processor, mask and detector of a [`PipelineConfig`], fed one frame at a time.
@@ -41,9 +41,11 @@ impl DetectionStage {
             .map(sillage_io::read_image)
             .transpose()?;
         let detector = match &config.detector {
-            DetectorConfig::Blob(params) => AnyDetector::Blob(BlobDetector::new(*params)?),
+            DetectorConfig::Blob(params) => {
+                AnyDetector::Blob(Box::new(BlobDetector::new(*params)?))
+            }
             DetectorConfig::Bead(bead) => {
-                AnyDetector::Bead(Box::new((bead.build()?, BeadDetections::default())))
+                AnyDetector::Bead(Box::new(bead.build()?), BeadDetections::default())
             }
         };
         Ok(Self {
@@ -103,8 +105,7 @@ impl DetectionStage {
         };
         match &mut self.detector {
             AnyDetector::Blob(detector) => detector.detect(image, out),
-            AnyDetector::Bead(bead) => {
-                let (detector, beads) = &mut **bead;
+            AnyDetector::Bead(detector, beads) => {
                 detect_frame(detector, frame, image, beads)?;
                 out.clear();
                 out.extend_from_slice(&beads.black);
@@ -129,7 +130,7 @@ impl DetectionStage {
     pub fn candidates(&self) -> &[Detection] {
         match &self.detector {
             AnyDetector::Blob(_) => &[],
-            AnyDetector::Bead(bead) => &bead.1.candidates,
+            AnyDetector::Bead(_, beads) => &beads.candidates,
         }
     }
 
@@ -138,7 +139,7 @@ impl DetectionStage {
     pub fn filtered(&self) -> Option<&GrayImage> {
         match &self.detector {
             AnyDetector::Blob(detector) => Some(detector.filtered()),
-            AnyDetector::Bead(_) => None,
+            AnyDetector::Bead(..) => None,
         }
     }
 
@@ -146,7 +147,7 @@ impl DetectionStage {
     pub fn last_threshold(&self) -> Option<f32> {
         match &self.detector {
             AnyDetector::Blob(detector) => detector.last_threshold(),
-            AnyDetector::Bead(_) => None,
+            AnyDetector::Bead(..) => None,
         }
     }
 }

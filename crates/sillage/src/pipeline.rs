@@ -16,14 +16,14 @@ use crate::detection_stage::DetectionStage;
 /// The built-in trackers, chosen by [`TrackerConfig`].
 enum AnyTracker {
     Ptv(PtvTracker),
-    Bedload(Box<BedloadTracker>),
+    Bedload(BedloadTracker),
 }
 
 impl AnyTracker {
     fn as_tracker(&mut self) -> &mut dyn Tracker {
         match self {
             AnyTracker::Ptv(t) => t,
-            AnyTracker::Bedload(t) => t.as_mut(),
+            AnyTracker::Bedload(t) => t,
         }
     }
 
@@ -153,9 +153,7 @@ impl Pipeline {
         config.validate()?;
         let tracker = match &config.tracker {
             TrackerConfig::Ptv(params) => AnyTracker::Ptv(PtvTracker::new(params.clone())?),
-            TrackerConfig::Bedload(params) => {
-                AnyTracker::Bedload(Box::new(BedloadTracker::new(params)?))
-            }
+            TrackerConfig::Bedload(params) => AnyTracker::Bedload(BedloadTracker::new(params)?),
         };
         Ok(Self {
             stage: DetectionStage::from_config(config)?,
@@ -437,7 +435,6 @@ impl Pipeline {
 #[cfg(test)]
 mod tests {
     use sillage_core::{Point2, TRANSPARENT_BEAD_CLASS};
-    use sillage_track::bedload::BedloadTrackerParams;
 
     use super::*;
 
@@ -446,7 +443,7 @@ mod tests {
     #[test]
     fn detections_tables_carry_their_candidates_to_the_bedload_tracker() {
         let config = PipelineConfig {
-            tracker: TrackerConfig::Bedload(BedloadTrackerParams::default()),
+            tracker: TrackerConfig::Bedload(Box::default()),
             ..PipelineConfig::default()
         };
         let mut pipeline = Pipeline::from_config(&config).unwrap();

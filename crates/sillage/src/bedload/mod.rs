@@ -75,7 +75,7 @@ fn bead_frame(frames: &mut BTreeMap<FrameIndex, BeadFrame>, frame: FrameIndex) -
 /// The pipeline of one bedload tracker over detections made elsewhere.
 fn bedload_pipeline(params: &BedloadTrackerParams) -> Result<Pipeline> {
     Pipeline::from_config(&PipelineConfig {
-        tracker: TrackerConfig::Bedload(params.clone()),
+        tracker: TrackerConfig::Bedload(Box::new(params.clone())),
         ..PipelineConfig::default()
     })
 }

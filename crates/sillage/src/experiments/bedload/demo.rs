@@ -92,11 +92,11 @@ pub fn track(
             params: synthetic_detector_params(scene, None),
             ..BeadDetectorConfig::default()
         }),
-        tracker: TrackerConfig::Bedload(BedloadTrackerParams {
+        tracker: TrackerConfig::Bedload(Box::new(BedloadTrackerParams {
             radius_px: synthetic_radii(scene).to_vec(),
             seed,
             ..BedloadTrackerParams::default()
-        }),
+        })),
         ..PipelineConfig::default()
     };
     let path = out.join("tracks.csv");
