@@ -80,10 +80,10 @@ fn tracking(
     let setup = match tracker {
         "ptv" => pipeline_config(None, None, overrides).map(Tracking::Pipeline),
         "bedload" => bead_detector(files).and_then(|detector| {
-            let tracker = TrackerConfig::Bedload(BedloadTrackerParams {
+            let tracker = TrackerConfig::Bedload(Box::new(BedloadTrackerParams {
                 seed,
                 ..BedloadTrackerParams::default()
-            });
+            }));
             pipeline_config(Some(detector), Some(tracker), overrides).map(Tracking::Pipeline)
         }),
         "immpf" => load::<ImmpfSettings>(None, overrides).and_then(|settings| {

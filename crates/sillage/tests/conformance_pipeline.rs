@@ -14,7 +14,6 @@ use sillage::bedload::detector::BeadDetectorSources;
 use sillage::core::TrackPoint;
 use sillage::pedestrian::immpf::Scene;
 use sillage::pedestrian::{ImmpfSettings, SiftPfSettings};
-use sillage::track::bedload::BedloadTrackerParams;
 use sillage::tracking::{ImmpfSetup, SiftPfSetup};
 use sillage::{DetectorConfig, PipelineConfig, TrackerConfig, Tracking, track_source};
 
@@ -35,7 +34,7 @@ fn cases() -> Vec<(&'static str, String, Tracking, bool)> {
     .unwrap();
     let bedload = PipelineConfig {
         detector: DetectorConfig::Bead(bead_detector),
-        tracker: TrackerConfig::Bedload(BedloadTrackerParams::default()),
+        tracker: TrackerConfig::Bedload(Box::default()),
         ..PipelineConfig::default()
     };
     let pets = format!("{DATA}/pets09_s2l1/img1");
