@@ -4,7 +4,6 @@
 //! one large sparse component.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use sillage_core::BoundingBox;
 use sillage_eval::mot::{
     MotChallengeProtocol, MotData, MotEstimate, MotParams, MotTruth, Shape, Similarity, TruthRole,
     evaluate_mot,
@@ -20,12 +19,7 @@ const TUD: &str = concat!(
 );
 
 fn shape(row: &MotRow) -> Shape {
-    Shape::Box(BoundingBox {
-        left_px: row.left_px,
-        top_px: row.top_px,
-        width_px: row.width_px,
-        height_px: row.height_px,
-    })
+    Shape::Box(row.bbox())
 }
 
 fn tud() -> (Vec<MotTruth>, Vec<MotEstimate>) {

@@ -2,7 +2,6 @@
 //! on the TUD-Campus and TUD-Stadtmitte files shipped with py-motmetrics 1.4.0
 //! (`../shared/data/motmetrics_tud_reference/README.md`), every value to 1e-6.
 
-use sillage_core::BoundingBox;
 use sillage_eval::mot::{
     ClearMetrics, HotaMetrics, IdentityMetrics, MotChallengeProtocol, MotConvention, MotData,
     MotEstimate, MotMetrics, MotParams, MotReport, MotTruth, Shape, Similarity, clear_events,
@@ -16,12 +15,7 @@ const DATA: &str = concat!(
 );
 
 fn shape(row: &MotRow) -> Shape {
-    Shape::Box(BoundingBox {
-        left_px: row.left_px,
-        top_px: row.top_px,
-        width_px: row.width_px,
-        height_px: row.height_px,
-    })
+    Shape::Box(row.bbox())
 }
 
 /// The evaluation data of one sequence: `gt.txt` against `test.txt`, box IoU.

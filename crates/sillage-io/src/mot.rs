@@ -16,7 +16,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use sillage_core::{Error, FrameIndex, Result};
+use sillage_core::{BoundingBox, Error, FrameIndex, Result};
 
 use crate::WrittenSummary;
 use crate::text_table::{RowWriter, push_f64};
@@ -48,6 +48,35 @@ pub struct MotRow {
     /// 8th to 10th columns of 10-field rows: world coordinates (MOT15 3D); `None` when
     /// absent or all `-1`.
     pub world: Option<[f64; 3]>,
+}
+
+impl MotRow {
+    /// A tracker's result row: track `id`'s `bbox` in `frame`, confidence 1, no world
+    /// coordinates.
+    pub fn result(frame: FrameIndex, id: u64, bbox: &BoundingBox) -> Self {
+        Self {
+            frame,
+            id: Some(id),
+            left_px: bbox.left_px,
+            top_px: bbox.top_px,
+            width_px: bbox.width_px,
+            height_px: bbox.height_px,
+            confidence: Some(1.0),
+            class: None,
+            visibility: None,
+            world: None,
+        }
+    }
+
+    /// The row's box.
+    pub fn bbox(&self) -> BoundingBox {
+        BoundingBox {
+            left_px: self.left_px,
+            top_px: self.top_px,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        }
+    }
 }
 
 /// What to read in a sequence folder.

@@ -139,15 +139,7 @@ pub fn track_source(
             let points: Vec<TrackPoint> = run
                 .rows
                 .iter()
-                .map(|row| {
-                    let bbox = BoundingBox {
-                        left_px: row.left_px,
-                        top_px: row.top_px,
-                        width_px: row.width_px,
-                        height_px: row.height_px,
-                    };
-                    person_point(row.frame, row.id.unwrap_or_default(), bbox, None)
-                })
+                .map(|row| person_point(row.frame, row.id.unwrap_or_default(), row.bbox(), None))
                 .collect();
             sink.accept(&points)?;
             Ok(run.frames)

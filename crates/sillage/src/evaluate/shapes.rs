@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use sillage_core::{BoundingBox, Error, FrameIndex, Result};
+use sillage_core::{Error, FrameIndex, Result};
 use sillage_eval::mot::{MatchRule, MotChallengeProtocol, MotEstimate, MotTruth, Shape, TruthRole};
 use sillage_eval::papers::StateLabel;
 use sillage_io::{BeadPoint, BeadSequenceParams, read_bead_sequence_params};
@@ -189,12 +189,7 @@ impl Shapes {
                             ),
                         )
                     })?;
-                    let shape = Shape::Box(BoundingBox {
-                        left_px: r.left_px,
-                        top_px: r.top_px,
-                        width_px: r.width_px,
-                        height_px: r.height_px,
-                    });
+                    let shape = Shape::Box(r.bbox());
                     Ok((r.frame, id, shape))
                 })
                 .collect(),

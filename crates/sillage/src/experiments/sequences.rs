@@ -7,13 +7,14 @@ use std::path::Path;
 use sillage_core::BoundingBox;
 use sillage_core::{Error, FrameIndex, Result};
 use sillage_eval::MotData;
-use sillage_eval::mot::{MotChallengeProtocol, MotEstimate, MotTruth, Shape, Similarity};
-use sillage_io::{MotFileRole, read_mot_sequence};
+use sillage_eval::mot::{MatchRule, MotChallengeProtocol, MotEstimate, MotTruth, Shape};
+
+use crate::evaluate::load_truth;
 
 use crate::pedestrian::within;
 
 /// Boxes match when their IoU is at least 0.5 (CLEAR MOT's usual rule, and the papers').
-const BOX_MATCH: Similarity = Similarity::BoxIou;
+const BOX_MATCH: MatchRule = MatchRule::Iou { threshold: 0.5 };
 
 /// A sequence folder's name: its last path component.
 pub fn sequence_name(folder: &Path) -> String {
@@ -31,49 +32,19 @@ pub struct SequenceTruth {
 }
 
 impl SequenceTruth {
-    /// Reads `folder/gt/gt.txt` (and the `seqinfo.ini` beside it): the boxes of every row,
-    /// scored or skipped by the MOT15 protocol.
+    /// Reads `folder/gt/gt.txt` (and the `seqinfo.ini` beside it) as `sillage eval mot`
+    /// reads it: the boxes of every row, scored or skipped by the MOT15 protocol.
     pub fn load(folder: &Path) -> Result<Self> {
         let gt = folder.join("gt").join("gt.txt");
-        let context = |e| {
-            let what = format!(
-                "cannot read the ground truth of {}; a sequence folder holds gt/gt.txt",
-                folder.display()
-            );
-            within(what, e)
-        };
-        let file = read_mot_sequence(&gt, MotFileRole::GroundTruth).map_err(context)?;
-        let truth = file
-            .rows
-            .iter()
-            .map(|r| {
-                let id = r.id.ok_or_else(|| {
-                    Error::input(format!(
-                        "{}: a row of frame {} has id -1; every row needs an object or track \
-                         id in column 2",
-                        gt.display(),
-                        r.frame + 1
-                    ))
-                })?;
-                Ok(MotTruth {
-                    frame: r.frame,
-                    id,
-                    shape: Shape::Box(BoundingBox {
-                        left_px: r.left_px,
-                        top_px: r.top_px,
-                        width_px: r.width_px,
-                        height_px: r.height_px,
-                    }),
-                    role: MotChallengeProtocol::Mot15
-                        .truth_role(r.confidence.unwrap_or(1.0), r.class),
-                })
-            })
-            .collect::<Result<_>>()
-            .map_err(context)?;
-        Ok(Self {
-            truth,
-            frame_count: file.seqinfo.and_then(|info| info.frame_count),
-        })
+        let (truth, frame_count) = load_truth(&gt, BOX_MATCH, MotChallengeProtocol::Mot15)
+            .map_err(|e| {
+                let what = format!(
+                    "cannot read the ground truth of {}; a sequence folder holds gt/gt.txt",
+                    folder.display()
+                );
+                within(what, e)
+            })?;
+        Ok(Self { truth, frame_count })
     }
 
     /// The evaluation data of `boxes` (`(frame, id, box)`, 0-based frames) against the
@@ -100,7 +71,7 @@ impl SequenceTruth {
         MotData::new(
             &truth,
             &estimates,
-            BOX_MATCH,
+            BOX_MATCH.similarity(),
             self.frame_count.map(|n| n.min(frames)),
         )
     }

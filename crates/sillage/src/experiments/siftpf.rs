@@ -9,7 +9,6 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use serde::Serialize;
-use sillage_core::BoundingBox;
 use sillage_core::{Error, Homography, Result};
 use sillage_eval::mot::{MotMetrics, MotParams, clear_events, evaluate_mot};
 use sillage_eval::papers::{EtiseoMetrics, etiseo};
@@ -309,12 +308,7 @@ impl RunOf<'_> {
             on_frame,
         )?;
         let boxes = run.rows.iter().filter_map(|r| {
-            let bbox = BoundingBox {
-                left_px: r.left_px,
-                top_px: r.top_px,
-                width_px: r.width_px,
-                height_px: r.height_px,
-            };
+            let bbox = r.bbox();
             Some((r.frame, r.id?, bbox))
         });
         let data = self.sequence.truth.data(boxes, run.frames)?;

@@ -147,18 +147,7 @@ pub fn step(
 pub fn mot_rows(estimates: &[PedestrianEstimate]) -> Vec<MotRow> {
     estimates
         .iter()
-        .map(|e| MotRow {
-            frame: e.frame,
-            id: Some(e.track_id),
-            left_px: e.bbox.left_px,
-            top_px: e.bbox.top_px,
-            width_px: e.bbox.width_px,
-            height_px: e.bbox.height_px,
-            confidence: Some(1.0),
-            class: None,
-            visibility: None,
-            world: None,
-        })
+        .map(|e| MotRow::result(e.frame, e.track_id, &e.bbox))
         .collect()
 }
 

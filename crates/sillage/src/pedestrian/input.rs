@@ -5,8 +5,8 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use sillage_core::{BoundingBox, Error, FrameIndex, GrayImage, Result, RgbImage};
-use sillage_detect::motion::{MotionBlob, MotionDetector, MotionParams};
+use sillage_core::{Error, FrameIndex, GrayImage, Result, RgbImage};
+use sillage_detect::motion::{MotionBlob, MotionDetector, MotionParams, blob_box};
 use sillage_io::{FrameOptions, FrameSource, open_frames, read_mot_rows};
 use sillage_track::immpf::{AppearanceParams, Candidate, FrameCues};
 
@@ -57,12 +57,7 @@ pub fn read_candidates(path: &Path) -> Result<BTreeMap<FrameIndex, Vec<Candidate
     let mut frames: BTreeMap<FrameIndex, Vec<Candidate>> = BTreeMap::new();
     for row in rows {
         frames.entry(row.frame).or_default().push(Candidate {
-            bbox: BoundingBox {
-                left_px: row.left_px,
-                top_px: row.top_px,
-                width_px: row.width_px,
-                height_px: row.height_px,
-            },
+            bbox: row.bbox(),
             score: row.confidence.unwrap_or(1.0),
         });
     }
@@ -227,12 +222,7 @@ impl PedestrianInput {
 /// A motion blob as a birth candidate (score 1).
 fn blob_candidate(blob: &MotionBlob) -> Candidate {
     Candidate {
-        bbox: BoundingBox {
-            left_px: blob.bbox.x0 as f64,
-            top_px: blob.bbox.y0 as f64,
-            width_px: blob.bbox.width() as f64,
-            height_px: blob.bbox.height() as f64,
-        },
+        bbox: blob_box(blob),
         score: 1.0,
     }
 }

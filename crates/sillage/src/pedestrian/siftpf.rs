@@ -98,25 +98,12 @@ pub fn track_siftpf(
     }
     estimates.sort_by_key(|e| (e.frame, e.id));
     Ok(SiftPfRun {
-        rows: estimates.iter().map(mot_row).collect(),
+        rows: estimates
+            .iter()
+            .map(|e| MotRow::result(e.frame, e.id, &e.bbox))
+            .collect(),
         frames: count,
         tracking,
         total: started.elapsed(),
     })
-}
-
-/// An estimate as a MOTChallenge result row (confidence 1).
-fn mot_row(e: &SiftPfEstimate) -> MotRow {
-    MotRow {
-        frame: e.frame,
-        id: Some(e.id),
-        left_px: e.bbox.left_px,
-        top_px: e.bbox.top_px,
-        width_px: e.bbox.width_px,
-        height_px: e.bbox.height_px,
-        confidence: Some(1.0),
-        class: None,
-        visibility: None,
-        world: None,
-    }
 }

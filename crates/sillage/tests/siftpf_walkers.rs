@@ -1,20 +1,19 @@
-//! The SIFT-PF tracker on generated walkers with ground truth: two people crossing with a
-//! full occlusion keep their identities; a group that enters together and splits gets new
-//! identities after the split; the output does not depend on the thread count; bad frames
-//! are errors.
+//! The SIFT-PF tracker on generated walkers with ground truth, fed by the motion detector
+//! through the facade's glue (`sillage::pedestrian::siftpf::detected_objects`): two people
+//! crossing with a full occlusion keep their identities; a group that enters together and
+//! splits gets new identities after the split; the output does not depend on the thread
+//! count; bad frames are errors.
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use sillage_core::BoundingBox;
-use sillage_core::{FrameIndex, Image};
-use sillage_detect::motion::{MotionDetector, MotionParams};
-use sillage_synth::{
+use sillage::core::{BoundingBox, FrameIndex, Image};
+use sillage::detect::motion::{MotionDetector, MotionParams};
+use sillage::pedestrian::siftpf::detected_objects;
+use sillage::synth::{
     CrossingParams, GroupSplitParams, Scenario, WalkerTruth, WalkersFrame, WalkersParams,
     WalkersSequence,
 };
-use sillage_track::siftpf::{
-    DetectedObject, SiftPfEstimate, SiftPfFrame, SiftPfParams, SiftPfTracker,
-};
+use sillage::track::siftpf::{SiftPfEstimate, SiftPfFrame, SiftPfParams, SiftPfTracker};
 
 /// Runs motion detection and the tracker over `frames`; every reported box.
 fn track(frames: &[WalkersFrame], seed: u64) -> Vec<SiftPfEstimate> {
@@ -25,14 +24,7 @@ fn track(frames: &[WalkersFrame], seed: u64) -> Vec<SiftPfEstimate> {
     let mut out = Vec::new();
     for f in frames {
         motion.detect(&f.grey, &mut blobs).unwrap();
-        let detections: Vec<DetectedObject> = blobs
-            .drain(..)
-            .map(|b| DetectedObject {
-                bbox: b.bbox,
-                mask: b.mask,
-                cut_from: b.cut_from,
-            })
-            .collect();
+        let detections = detected_objects(&mut blobs);
         let found = tracker
             .step(SiftPfFrame {
                 frame: f.index,
