@@ -7,6 +7,7 @@
 mod bedload;
 mod errors;
 mod eval;
+mod experiments;
 mod frames;
 mod hooks;
 mod linking;
@@ -227,6 +228,9 @@ fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(bedload::track_bedload, module)?)?;
     module.add_function(wrap_pyfunction!(sources::track, module)?)?;
     module.add_function(wrap_pyfunction!(sources::detect, module)?)?;
+    module.add_function(wrap_pyfunction!(experiments::fit, module)?)?;
+    module.add_function(wrap_pyfunction!(experiments::bench_immpf, module)?)?;
+    module.add_function(wrap_pyfunction!(experiments::bench_siftpf, module)?)?;
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -78,22 +78,23 @@ fn tracking(
     files: &SceneFiles,
 ) -> PyResult<Tracking> {
     let setup = match tracker {
-        "ptv" => pipeline_config(None, None, overrides).map(Tracking::Pipeline),
+        "ptv" => pipeline_config(None, None, overrides).map(|c| Tracking::Pipeline(Box::new(c))),
         "bedload" => bead_detector(files).and_then(|detector| {
             let tracker = TrackerConfig::Bedload(Box::new(BedloadTrackerParams {
                 seed,
                 ..BedloadTrackerParams::default()
             }));
-            pipeline_config(Some(detector), Some(tracker), overrides).map(Tracking::Pipeline)
+            pipeline_config(Some(detector), Some(tracker), overrides)
+                .map(|c| Tracking::Pipeline(Box::new(c)))
         }),
         "immpf" => load::<ImmpfSettings>(None, overrides).and_then(|settings| {
             let scene = Scene::load(files.ground_plane.as_deref(), files.motion_prior.as_deref())?;
-            Ok(Tracking::Immpf(ImmpfSetup {
+            Ok(Tracking::Immpf(Box::new(ImmpfSetup {
                 settings,
                 scene,
                 seed,
                 detections: files.detections.clone(),
-            }))
+            })))
         }),
         "siftpf" => load::<SiftPfSettings>(None, overrides).and_then(|settings| {
             let homography = files
@@ -101,11 +102,11 @@ fn tracking(
                 .as_deref()
                 .map(GroundPlaneFile::read_homography)
                 .transpose()?;
-            Ok(Tracking::Siftpf(SiftPfSetup {
+            Ok(Tracking::Siftpf(Box::new(SiftPfSetup {
                 settings,
                 homography,
                 seed,
-            }))
+            })))
         }),
         other => {
             return Err(PyValueError::new_err(format!(
@@ -200,10 +201,10 @@ pub fn detect<'py>(
         ..SceneFiles::default()
     };
     let detecting = match detector {
-        "blob" => pipeline_config(None, None, &overrides).map(Detecting::Pipeline),
+        "blob" => pipeline_config(None, None, &overrides).map(|c| Detecting::Pipeline(Box::new(c))),
         "bead" => bead_detector(&files)
             .and_then(|bead| pipeline_config(Some(bead), None, &overrides))
-            .map(Detecting::Pipeline),
+            .map(|c| Detecting::Pipeline(Box::new(c))),
         "motion" => motion_params(&overrides).map(Detecting::Motion),
         other => {
             return Err(PyValueError::new_err(format!(

@@ -459,3 +459,29 @@ def test_evaluate_names_what_a_rule_needs():
         sillage.evaluate(points, points, match="disc:0.43")
     with pytest.raises(ValueError, match="match"):
         sillage.evaluate(points, points, match="cosine:1")
+
+
+def test_fit_learns_what_the_command_line_learns_and_track_takes_it(tmp_path):
+    ground = tmp_path / "ground.toml"
+    plane = sillage.fit("homography", PETS.parent / "gt" / "gt.txt", out=ground)
+    assert plane["boxes"] > 100 and ground.exists()
+    people = sillage.track(PETS, "immpf", ground_plane=ground, max_frames=30)
+    assert len(people) > 0
+    prior = sillage.fit("motion-prior", PETS.parent / "gt" / "gt.txt", out=tmp_path / "p.json")
+    assert prior["tracks"] > 5 and prior["width_px"] == 768
+    motion = sillage.fit("bedload", BEADS / "ground_truth" / "trackdatatruth.csv")
+    assert motion["tracks"] > 10 and "[motion" in motion["config"]
+    with pytest.raises(ValueError, match="unknown fit"):
+        sillage.fit("kalman", PETS)
+
+
+def test_bench_gives_the_paper_tables_as_dataframes():
+    table = sillage.bench("immpf", [PETS.parent], runs=1, models=["CV_CA"], max_frames=30)
+    assert list(table.models) == ["CV_CA"] and table.runs.iloc[0] == 1
+    assert 0 <= table.median_ata.iloc[0] <= 1
+    sift = sillage.bench("siftpf", [PETS.parent], runs=1, selections=["reliability"],
+                         max_frames=20)
+    assert list(sift.sequence) == ["pets09_s2l1", "COMBINED"]
+    assert (sift.frames == 20).all()
+    with pytest.raises(ValueError, match="unknown bench"):
+        sillage.bench("sort", [PETS.parent])

@@ -27,11 +27,11 @@ use crate::{Pipeline, PipelineConfig};
 #[derive(Debug, Clone)]
 pub enum Tracking {
     /// PTV or a bedload tracker, with the detector of the configuration ([`Pipeline`]).
-    Pipeline(PipelineConfig),
+    Pipeline(Box<PipelineConfig>),
     /// Pedestrians, one IMM particle filter each (Madrigal & Hayet).
-    Immpf(ImmpfSetup),
+    Immpf(Box<ImmpfSetup>),
     /// Surveillance objects followed by their SIFT features' particle filters (Souded et al.).
-    Siftpf(SiftPfSetup),
+    Siftpf(Box<SiftPfSetup>),
 }
 
 /// The IMM-PF tracker's settings, scene and seed.
@@ -151,10 +151,13 @@ pub fn track_source(
 #[derive(Debug, Clone)]
 pub enum Detecting {
     /// The blob or bead detector of the configuration, after its pre-processing.
-    Pipeline(PipelineConfig),
+    Pipeline(Box<PipelineConfig>),
     /// Moving blobs over a Gaussian-mixture background (the pedestrian trackers' births).
     Motion(MotionParams),
 }
+
+/// Receives each frame with its detections and their boxes (empty for point detectors).
+pub type DetectionSink<'a> = dyn FnMut(&Frame, &[Detection], &[BoundingBox]) -> Result<()> + 'a;
 
 /// Detects objects in every frame of `source` (the first `max_frames`), handing each frame
 /// with its detections and, for detectors of extended objects, their boxes (else empty) to
@@ -163,7 +166,7 @@ pub fn detect_source(
     source: &str,
     detecting: &Detecting,
     max_frames: Option<usize>,
-    each: &mut dyn FnMut(&Frame, &[Detection], &[BoundingBox]) -> Result<()>,
+    each: &mut DetectionSink<'_>,
 ) -> Result<()> {
     let options = FrameOptions {
         max_frames,

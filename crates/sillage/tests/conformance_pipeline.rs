@@ -53,17 +53,22 @@ fn cases() -> Vec<(&'static str, String, Tracking, bool)> {
         (
             "ptv",
             format!("{DATA}/trackpy_bulk_water/frames"),
-            Tracking::Pipeline(PipelineConfig::default()),
+            Tracking::Pipeline(Box::default()),
             false,
         ),
         (
             "bedload",
             format!("{beads}/images"),
-            Tracking::Pipeline(bedload),
+            Tracking::Pipeline(Box::new(bedload)),
             false,
         ),
-        ("immpf", pets.clone(), Tracking::Immpf(immpf), true),
-        ("siftpf", pets, Tracking::Siftpf(siftpf), true),
+        (
+            "immpf",
+            pets.clone(),
+            Tracking::Immpf(Box::new(immpf)),
+            true,
+        ),
+        ("siftpf", pets, Tracking::Siftpf(Box::new(siftpf)), true),
     ]
 }
 

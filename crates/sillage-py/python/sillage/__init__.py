@@ -43,7 +43,7 @@ from . import _sillage
 __version__ = _sillage.__version__
 
 __all__ = ["locate", "batch", "ptv", "ptv_iter", "link", "track", "detect", "track_bedload",
-           "evaluate", "synth_vortex", "synth_bedload", "config_keys"]
+           "evaluate", "fit", "bench", "synth_vortex", "synth_bedload", "config_keys"]
 
 #: Column order of detections (trackpy's ``locate`` puts ``y`` before ``x``).
 _DETECTION_COLUMNS = ["y", "x", "signal", "frame"]
@@ -402,6 +402,57 @@ def evaluate(truth: pd.DataFrame, tracks: pd.DataFrame, *, match: str | None = N
     if "papers" in combined:
         scores["papers"] = combined["papers"]
     return scores
+
+
+def fit(kind: str, truth: str | Any, *, out: str | Any | None = None) -> dict:
+    """Learns model parameters from ground truth, as ``sillage fit KIND`` does.
+
+    ``kind`` is ``"bedload"`` (the MMPF+ motion parameters and transition table from a
+    BeadTracking truth with motion states), ``"homography"`` (the image ↔ ground homography
+    and the adult's box size from a MOT15 ``gt.txt`` with world coordinates) or
+    ``"motion-prior"`` (the IMM-PF's learned motion prior, 30-px cells, from a MOTChallenge
+    ``gt.txt``). ``out`` writes the file the command line writes (a bedload TOML
+    configuration, a ground-plane TOML, a prior JSON), which :func:`track` then takes
+    (``params``, ``ground_plane=``, ``motion_prior=``). Returns what was fitted as a dict.
+
+    >>> sillage.fit("homography", "PETS09-S2L1/gt/gt.txt", out="ground.toml")["boxes"]
+    """
+    return json.loads(_sillage.fit(kind, _path(truth), _optional_path(out)))
+
+
+def bench(kind: str, sequences: Iterable[str | Any], *, runs: int = 1,
+          models: Iterable[str] = ("CV", "CA", "CV_CA"),
+          selections: Iterable[str] = ("whole-object", "detection-order", "reliability"),
+          ground_plane: str | Any | None = None, max_frames: int | None = None,
+          params: Mapping[str, Any] | None = None, progress: bool = False,
+          **keywords: Any) -> pd.DataFrame:
+    """A paper's table on MOTChallenge sequence folders (``img1/``, ``gt/gt.txt``), as
+    ``sillage bench immpf|siftpf`` computes it: one row per sequence and model combination
+    (``kind="immpf"``, ``models`` as the paper writes them) or feature selection
+    (``kind="siftpf"``, ``selections`` among whole-object, detection-order, reliability),
+    each score the median over the seeds ``1..runs``. Keywords are ``tracker`` keys of that
+    tracker. Returns a DataFrame (scores as columns; for SIFT-PF the rows of all sequences
+    combined come last, ``sequence == "COMBINED"``).
+
+    >>> sillage.bench("immpf", ["PETS09-S2L1"], runs=5, models=["CV_CA", "CV_CA_MP"])
+    """
+    folders = [_path(s) for s in sequences]
+    overrides = _overrides(keywords, params, "tracker")
+    total = None
+    with _progress(progress, total, f"bench {kind}") as update:
+        if kind == "immpf":
+            rows = json.loads(_sillage.bench_immpf(folders, list(models), int(runs), overrides,
+                                                   _optional_path(ground_plane), max_frames,
+                                                   update))
+        elif kind == "siftpf":
+            report = json.loads(_sillage.bench_siftpf(folders, [str(s) for s in selections],
+                                                      int(runs), overrides,
+                                                      _optional_path(ground_plane), max_frames,
+                                                      update))
+            rows = report["sequences"] + report["combined"]
+        else:
+            raise ValueError(f"unknown bench `{kind}`; choose immpf or siftpf")
+    return pd.json_normalize(rows, sep="_")
 
 
 def synth_vortex(**params: Any) -> tuple[np.ndarray, pd.DataFrame]:

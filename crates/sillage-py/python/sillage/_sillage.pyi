@@ -62,3 +62,22 @@ def detect(
     max_frames: Optional[int] = None,
     progress: Progress = None,
 ) -> Columns: ...
+def fit(kind: str, truth: str, out: Optional[str] = None) -> str: ...
+def bench_immpf(
+    folders: list[str],
+    combinations: list[str],
+    runs: int,
+    overrides: list[str],
+    ground_plane: Optional[str] = None,
+    max_frames: Optional[int] = None,
+    progress: Progress = None,
+) -> str: ...
+def bench_siftpf(
+    folders: list[str],
+    selections: list[str],
+    runs: int,
+    overrides: list[str],
+    ground_plane: Optional[str] = None,
+    max_frames: Optional[int] = None,
+    progress: Progress = None,
+) -> str: ...
