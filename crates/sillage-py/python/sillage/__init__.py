@@ -358,6 +358,8 @@ def evaluate(truth: pd.DataFrame, tracks: pd.DataFrame, *, match: str | None = N
     >>> scores["clear"]["mota"], scores["identity"]["idf1"]
     """
     if match is None:
+        if match_px is not None and not float(match_px) > 0:
+            raise ValueError(f"match_px = {match_px}: give a distance > 0 px")
         match = f"dist:{1.0 if match_px is None else float(match_px)}"
     elif match_px is not None:
         raise ValueError("give match (e.g. match='dist:2') or match_px, not both")
