@@ -2,9 +2,31 @@
 //! the process's peak memory, for a sweep of particle counts and frame sizes.
 
 use anyhow::Result;
+use clap::Args;
 use sillage::ptv_bench::{bench_ptv_case, stream_memory};
 
-use crate::cli::BenchPtvArgs;
+use crate::shared_args::JsonArg;
+
+/// `sillage bench ptv`.
+#[derive(Debug, Args)]
+pub struct BenchPtvArgs {
+    /// Particle counts to time, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 5000, 25000])]
+    pub particles: Vec<usize>,
+    /// Frame sizes to time (square, px), comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1024, 2048])]
+    pub sizes: Vec<usize>,
+    /// Frames timed per case (after 3 warm-up frames).
+    #[arg(long, default_value_t = 20)]
+    pub frames: usize,
+    /// Instead of the sweep, stream this many frames (first size and particle count) and print
+    /// the resident memory every tenth of the way.
+    #[arg(long, value_name = "FRAMES")]
+    pub stream: Option<usize>,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 /// `sillage bench ptv`.
 pub fn run_ptv(args: &BenchPtvArgs) -> Result<()> {
@@ -22,7 +44,7 @@ pub fn run_ptv(args: &BenchPtvArgs) -> Result<()> {
         .map(|n| n.get())
         .unwrap_or(1);
     let mut rows = Vec::new();
-    if !args.json {
+    if !args.json.enabled {
         println!(
             "sillage bench ptv: {threads} threads, {} timed frames per case",
             args.frames
@@ -42,7 +64,7 @@ pub fn run_ptv(args: &BenchPtvArgs) -> Result<()> {
     for &size in &args.sizes {
         for &particles in &args.particles {
             let row = bench_ptv_case(size, particles, args.frames)?;
-            if !args.json {
+            if !args.json.enabled {
                 println!(
                     "{:>6} {:>9} {:>11.0} {:>10.0} {:>11.2} {:>10.2} {:>10.2} {:>10}",
                     row.size_px,
@@ -58,7 +80,7 @@ pub fn run_ptv(args: &BenchPtvArgs) -> Result<()> {
             rows.push(row);
         }
     }
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&rows)?);
     }
     Ok(())

@@ -6,7 +6,10 @@
 //! `--plots DIR` draws Figs. 6 and 7. The rows are computed by
 //! `sillage::experiments::bedload`; this prints them.
 
+use std::path::PathBuf;
+
 use anyhow::Result;
+use clap::Args;
 use sillage::bedload::detector::BeadDetectorSources;
 use sillage::eval::Table;
 use sillage::experiments::bedload::figures::write_figures;
@@ -14,8 +17,36 @@ use sillage::experiments::bedload::sequences::Sequence;
 use sillage::experiments::bedload::{Row, Scope, TABLE_THRESHOLD, evaluate, lowest_threshold};
 use sillage::track::bedload::BedloadTrackerKind;
 
-use crate::cli::BenchBedloadArgs;
 use crate::progress::FrameProgress;
+use crate::shared_args::{BeadDetectorArgs, JsonArg};
+
+/// `sillage bench bedload`.
+#[derive(Debug, Args)]
+pub struct BenchBedloadArgs {
+    /// Frames of the synthetic sequence.
+    #[arg(long, default_value_t = 100)]
+    pub frames: usize,
+    /// Seed of the synthetic sequence.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// A real sequence in BeadTracking's layout (images/, ground_truth/trackdatatruth.csv,
+    /// sequence_param.txt), detected with the options below.
+    #[arg(long, value_name = "DIR")]
+    pub real: Option<PathBuf>,
+    /// The detector, for --real.
+    #[command(flatten)]
+    pub detector: BeadDetectorArgs,
+    /// The τ_t values of the Fig. 6 sweep, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [0.15, 0.17, 0.19, 0.21, 0.23, 0.25, 0.27, 0.29, 0.31, 0.33, 0.35])]
+    pub thresholds: Vec<f64>,
+    /// Draw Fig. 6 (correct tracks and MOTA of transparent beads against τ_t) and Fig. 7
+    /// (motion-state F-scores) into this folder, as PNG and SVG.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 fn print_table1(rows: &[&Row]) {
     let header = [
@@ -107,7 +138,7 @@ pub fn run(args: &BenchBedloadArgs) -> Result<()> {
         let written = write_figures(dir, &rows)?;
         eprintln!("figures: {}", written.join(", "));
     }
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&rows)?);
     } else {
         let (table1, sweep): (Vec<&Row>, Vec<&Row>) =

@@ -1,15 +1,42 @@
 //! `sillage demo`: a synthetic vortex sequence written to disk, tracked from the files,
 //! written in every format, scored against its truth.
 
+use std::path::PathBuf;
+
 use anyhow::Result;
+use clap::Args;
 use sillage::PipelineConfig;
 use sillage::demo::{score_demo, track_in_every_format};
 use sillage::ptv_run::PtvRun;
 use sillage::synth::vortex::VortexParams;
 
-use crate::cli::DemoArgs;
+use crate::cli::DemoKind;
 use crate::progress::FrameProgress;
+use crate::shared_args::JsonArg;
 use crate::synth::write_vortex_with_progress;
+
+/// `sillage demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Output folder for frames, truth and tracks.
+    #[arg(long, short, default_value = "out/demo", value_name = "DIR")]
+    pub out: PathBuf,
+    /// Number of frames.
+    #[arg(long, default_value_t = 40)]
+    pub frames: usize,
+    /// Number of particles.
+    #[arg(long, default_value_t = 1000)]
+    pub particles: usize,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+    /// Another demo than the PTV one.
+    #[command(subcommand)]
+    pub kind: Option<DemoKind>,
+}
 
 /// `sillage demo`.
 pub fn run(args: &DemoArgs) -> Result<()> {
@@ -43,7 +70,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
 
     eprintln!("3/3 scoring against {}", truth_path.display());
     let summary = score_demo(&truth_path, tracks)?;
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         let run = &summary.run;

@@ -3,16 +3,39 @@
 //! against the truth as the MMPF+ paper scores (Table 1). The steps are
 //! `sillage::experiments::bedload::demo`'s; this shows their progress and prints the scores.
 
+use std::path::PathBuf;
+
 use anyhow::Result;
+use clap::Args;
 use serde::Serialize;
 use sillage::bedload::synth::synthetic_radii;
 use sillage::eval::papers::{BeadTrackScores, score_bead_tracks};
 use sillage::experiments::bedload::demo::{demo_scene, frames_dir, render, track};
 use sillage::viz::OverlayStyle;
 
-use crate::cli::DemoBedloadArgs;
 use crate::overlay::write_overlays;
 use crate::progress::FrameProgress;
+use crate::shared_args::JsonArg;
+
+/// `sillage demo bedload`.
+#[derive(Debug, Args)]
+pub struct DemoBedloadArgs {
+    /// Output folder for frames, truth and tracks.
+    #[arg(long, short, default_value = "out/demo_bedload", value_name = "DIR")]
+    pub out: PathBuf,
+    /// Number of frames.
+    #[arg(long, default_value_t = 100)]
+    pub frames: usize,
+    /// Random seed (scene and particles).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Also draw every frame with its detections and track tails into OUT/overlays.
+    #[arg(long)]
+    pub overlays: bool,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 /// The demo's summary.
 #[derive(Serialize)]
@@ -75,7 +98,7 @@ pub fn run(args: &DemoBedloadArgs) -> Result<()> {
         scores: score_bead_tracks(&truth, &tracks.points, &radii)?,
         tracks: tracks.path.display().to_string(),
     };
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         let t = &summary.scores.table1;

@@ -5,14 +5,41 @@
 
 use std::fmt::Write as _;
 use std::path::Path;
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
+use clap::Args;
 use serde::Serialize;
 use sillage::bedload::fit::{config_text, read_state_tracks, tracks_without_state};
 use sillage::filter::fit::STATE_NAMES;
 use sillage::filter::{BedloadFit, BedloadParams, FitOptions, FitReport, fit_bedload};
 
-use crate::cli::FitBedloadArgs;
+use crate::shared_args::JsonArg;
+
+/// `sillage fit bedload`.
+#[derive(Debug, Args)]
+pub struct FitBedloadArgs {
+    /// Ground truth with motion states: a BeadTracking CSV
+    /// (frame,id,x,y,category,vx,vy,motion_state).
+    #[arg(long, value_name = "FILE")]
+    pub truth: PathBuf,
+    /// TOML file to write; its `[motion]` table holds the fitted parameters.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Share of the frame range to train on, from the first frame, in (0, 1].
+    #[arg(long, value_name = "F", default_value_t = FitOptions::default().train_fraction)]
+    pub train_fraction: f64,
+    /// Minimal transition probability imposed on each fitted row, in [0, 1/3]; 0 keeps the raw
+    /// estimate.
+    #[arg(long, value_name = "P", default_value_t = FitOptions::default().min_probability)]
+    pub min_probability: f64,
+    /// Fewest samples for a state's row or noises to be fitted; below, the default is kept.
+    #[arg(long, value_name = "N", default_value_t = FitOptions::default().min_samples)]
+    pub min_samples: u64,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 /// `--json`: what was read, the options, the fitted parameters and the report.
 #[derive(Serialize)]
@@ -57,7 +84,7 @@ pub fn run_bedload(args: &FitBedloadArgs) -> Result<()> {
         tracks_without_state,
     )?;
     write_config(&args.out, &text)?;
-    if args.json {
+    if args.json.enabled {
         let summary = JsonSummary {
             truth: &args.truth,
             out: &args.out,

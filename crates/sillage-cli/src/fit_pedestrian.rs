@@ -4,14 +4,69 @@
 //! size in metres (§4) as TOML (`sillage::pedestrian::{motion_prior, homography}`).
 
 use std::path::Path;
+use std::path::PathBuf;
 
 use anyhow::{Result, bail};
+use clap::Args;
 use serde::Serialize;
 use sillage::filter::MotionPriorParams;
 use sillage::pedestrian::homography::{HomographySource, fit_homography};
 use sillage::pedestrian::motion_prior::{fit_motion_prior, write_motion_prior};
 
-use crate::cli::{FitHomographyArgs, FitMotionPriorArgs};
+use crate::shared_args::JsonArg;
+
+/// `sillage fit motion-prior`.
+#[derive(Debug, Args)]
+pub struct FitMotionPriorArgs {
+    /// Trajectories in MOTChallenge format (`gt.txt` or tracker output; rows with flag 0 are
+    /// ignored), or a sequence folder holding `gt/gt.txt`.
+    #[arg(value_name = "TRACKS")]
+    pub tracks: PathBuf,
+    /// Image width, px; default `imWidth` of the `seqinfo.ini` beside the file or above it.
+    #[arg(long, value_name = "PX")]
+    pub width: Option<u32>,
+    /// Image height, px; default `imHeight` of that `seqinfo.ini`.
+    #[arg(long, value_name = "PX")]
+    pub height: Option<u32>,
+    /// Cell side, px (§5.1 uses 30).
+    #[arg(long, value_name = "PX", default_value_t = MotionPriorParams::default().cell_px)]
+    pub cell: f64,
+    /// Steps slower than this count as "stay", px/frame.
+    #[arg(long, value_name = "PX", default_value_t = MotionPriorParams::default().min_speed_px_per_frame)]
+    pub min_speed: f64,
+    /// Dirichlet pseudo-count added to every bin of every cell.
+    #[arg(long, value_name = "N", default_value_t = MotionPriorParams::default().smoothing)]
+    pub smoothing: f64,
+    /// JSON file to write.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
+
+/// `sillage fit homography`.
+#[derive(Debug, Args)]
+pub struct FitHomographyArgs {
+    /// MOT15 ground truth with world coordinates
+    /// (`frame,id,bb_left,bb_top,bb_width,bb_height,flag,world_x,world_y,world_z`).
+    #[arg(
+        value_name = "GT",
+        required_unless_present = "points",
+        conflicts_with = "points"
+    )]
+    pub gt: Option<PathBuf>,
+    /// Instead of ground truth: a text file of 4 or more `u,v,x,y` lines (image px, ground m).
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+    /// TOML file to write: `[homography]` (image_from_ground), `[pedestrian]` (from ground
+    /// truth only) and `[fit]`.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 /// `--json` of `fit motion-prior`.
 #[derive(Serialize)]
@@ -52,7 +107,7 @@ pub fn run_motion_prior(args: &FitMotionPriorArgs) -> Result<()> {
         cells_with_data: fit.prior.cells_with_data(),
         ignored_rows: fit.ignored_rows,
     };
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         println!(
@@ -80,7 +135,7 @@ pub fn run_homography(args: &FitHomographyArgs) -> Result<()> {
     };
     let fit = fit_homography(source)?;
     fit.file.write(&args.out)?;
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&fit.file)?);
     } else if let Some(table) = &fit.file.fit {
         println!(

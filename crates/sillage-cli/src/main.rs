@@ -22,6 +22,7 @@ mod overlay;
 mod plot;
 mod progress;
 mod ptv;
+mod shared_args;
 mod synth;
 mod synth_bedload;
 mod synth_walkers;

@@ -3,18 +3,47 @@
 //! and, with `--mp4`, the same pictures as a video.
 
 use std::path::Path;
+use std::path::PathBuf;
 
 use anyhow::Result;
+use clap::Args;
 use sillage::core::TrackPoint;
 use sillage::io::read_detections_csv;
 pub use sillage::overlay::DetectionsByFrame;
 use sillage::overlay::VideoOut;
 use sillage::viz::{OverlayStyle, TrackHistory};
 
-use crate::cli::OverlayArgs;
 use crate::plot::colouring;
 use crate::progress::FrameProgress;
+use crate::shared_args::TracksInputArgs;
 use crate::track_input::read_tracks_for_drawing;
+
+/// `sillage overlay`.
+#[derive(Debug, Args)]
+pub struct OverlayArgs {
+    /// The tracks.
+    #[command(flatten)]
+    pub input: TracksInputArgs,
+    /// The frames the tracks were made from (a folder, a quoted glob, a multi-page TIFF or a
+    /// video).
+    #[arg(long, value_name = "FRAMES")]
+    pub frames: String,
+    /// Folder for the pictures, `overlay_NNNNN.png` (0-based frame index).
+    #[arg(long, short, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Also encode the pictures into this MP4 (through the `ffmpeg` program).
+    #[arg(long, value_name = "FILE.mp4")]
+    pub mp4: Option<PathBuf>,
+    /// Frames per second of the MP4.
+    #[arg(long, default_value_t = 10.0)]
+    pub fps: f64,
+    /// Frames of history in each track's tail.
+    #[arg(long, value_name = "FRAMES", default_value_t = 20)]
+    pub tail: u64,
+    /// Circle radius of the detections, px.
+    #[arg(long, value_name = "PX", default_value_t = 4.0)]
+    pub radius: f64,
+}
 
 /// `sillage overlay`: the frames with the tracks of a table (and the detections of a CSV).
 pub fn run(args: &OverlayArgs) -> Result<()> {

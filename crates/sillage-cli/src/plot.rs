@@ -3,16 +3,62 @@
 //! the log10 prediction errors, and counts of tracks and detections per frame.
 
 use std::path::Path;
+use std::path::PathBuf;
 
 use anyhow::{Result, bail};
+use clap::{Args, ValueEnum};
 use sillage::plots::{
     ColourBy, counts_chart, displacement_histogram, file_name, prediction_error_histogram,
     quiver_plot, track_colouring, write_plot,
 };
 use sillage::viz::{Plot, TrackColouring, TrackHistory, TrajectoryPlot};
 
-use crate::cli::{ColourArg, PlotArgs, PlotKind, TracksInputArgs};
+use crate::shared_args::{ColourArg, FrameSize, TracksInputArgs};
 use crate::track_input::read_tracks_for_drawing;
+
+/// The charts of `sillage plot`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PlotKind {
+    /// Every track as a line on the image plane (`--colour speed|state|id`).
+    Trajectories,
+    /// Velocity arrows at one frame (`--frame`).
+    Quiver,
+    /// Histogram of the displacement per frame (speed, px/frame).
+    Displacements,
+    /// Histogram of log10 of the prediction error (PTV tables).
+    PredictionError,
+    /// Tracks (and, with `--detections`, detections) per frame.
+    Counts,
+}
+
+/// `sillage plot`.
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    /// Which chart.
+    #[arg(value_enum)]
+    pub kind: PlotKind,
+    /// The tracks.
+    #[command(flatten)]
+    pub input: TracksInputArgs,
+    /// Picture to write: `.png` or `.svg`.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Frame of the velocity arrows (0-based; default: the frame with most tracks).
+    #[arg(long, value_name = "N")]
+    pub frame: Option<u64>,
+    /// Leave out tracks of fewer points.
+    #[arg(long, value_name = "L", default_value_t = 1)]
+    pub min_length: usize,
+    /// Picture size `WxH`, px.
+    #[arg(long, value_name = "WxH", default_value = "800x600")]
+    pub size: FrameSize,
+    /// Histogram bins.
+    #[arg(long, default_value_t = 50)]
+    pub bins: usize,
+    /// Histogram counts on a log scale.
+    #[arg(long)]
+    pub log_y: bool,
+}
 
 /// Runs `sillage plot`.
 pub fn run(args: &PlotArgs) -> Result<()> {

@@ -1,19 +1,41 @@
 //! `sillage ptv` and `sillage config`: configuration assembly and a tracking run.
 
+use std::path::PathBuf;
+
 use anyhow::Result;
+use clap::Args;
 use sillage::PipelineConfig;
 use sillage::io::TrackFormat;
 use sillage::ptv_run::{PtvRun, load_ptv_config};
 
-use crate::cli::{ConfigArgs, FormatArg, PtvArgs};
 use crate::progress::FrameProgress;
+use crate::shared_args::{ConfigArgs, FormatArg, JsonArg};
+
+/// `sillage ptv`.
+#[derive(Debug, Args)]
+pub struct PtvArgs {
+    /// Frames: a folder, a quoted glob pattern, a multi-page TIFF or a video file.
+    pub input: String,
+    /// Trajectory file to write (format from the extension unless --format is given).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Output format (default: from the extension of --out).
+    #[arg(long, value_enum)]
+    pub format: Option<FormatArg>,
+    /// Configuration sources.
+    #[command(flatten)]
+    pub config: ConfigArgs,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 /// Assembles the configuration: defaults, then `--config`, then `--tractrac-par`, then `--set`.
 pub fn load_config(args: &ConfigArgs) -> Result<PipelineConfig> {
     Ok(load_ptv_config(
-        args.config.as_deref(),
+        args.params.config.as_deref(),
         args.tractrac_par.as_deref(),
-        &args.overrides,
+        &args.params.overrides,
     )?)
 }
 
@@ -47,7 +69,7 @@ pub fn run(args: &PtvArgs) -> Result<()> {
     progress.finish();
     let tracked = outcome?;
     let summary = tracked.summary;
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         eprintln!(

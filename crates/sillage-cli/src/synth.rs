@@ -1,11 +1,48 @@
 //! `sillage synth vortex`: frames as 16-bit PNG and the ground truth as CSV.
 
+use std::path::PathBuf;
+
 use anyhow::Result;
+use clap::Args;
 use sillage::synth::vortex::VortexParams;
 use sillage::vortex_files::write_vortex;
 
-use crate::cli::VortexArgs;
 use crate::progress::FrameProgress;
+
+/// `sillage synth vortex`.
+#[derive(Debug, Args)]
+pub struct VortexArgs {
+    /// Output folder (created): frame_00000.png ... and truth.csv.
+    #[arg(long, short, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Number of frames.
+    #[arg(long, default_value_t = 50)]
+    pub frames: usize,
+    /// Number of particles.
+    #[arg(long, default_value_t = 1000)]
+    pub particles: usize,
+    /// Frame width, px.
+    #[arg(long, default_value_t = 1024)]
+    pub width: usize,
+    /// Frame height, px.
+    #[arg(long, default_value_t = 1024)]
+    pub height: usize,
+    /// Signal-to-noise ratio (blob peak over noise magnitude).
+    #[arg(long, default_value_t = 4.0)]
+    pub snr: f64,
+    /// Time step δ of Eqs. 13-16 (larger = faster flow).
+    #[arg(long, default_value_t = 0.01)]
+    pub delta: f64,
+    /// Share of particles re-seeded per frame (0-0.5).
+    #[arg(long, default_value_t = 0.0)]
+    pub intermittency: f64,
+    /// Brownian noise added to the displacements.
+    #[arg(long, default_value_t = 0.0)]
+    pub brownian: f64,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
 
 /// The vortex parameters of the command line, on top of the generator's defaults.
 fn vortex_params(args: &VortexArgs) -> VortexParams {

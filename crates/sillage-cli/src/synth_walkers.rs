@@ -1,13 +1,52 @@
 //! `sillage synth walkers`: a synthetic walkers sequence as a MOTChallenge sequence folder
 //! (`sillage::pedestrian::walkers`), its generator's parameters from the command line.
 
+use std::path::PathBuf;
+
 use anyhow::{Result, bail};
+use clap::{Args, ValueEnum};
 use sillage::core::Error;
 use sillage::pedestrian::walkers::write_walkers_sequence;
 use sillage::synth::{CrossingParams, GroupSplitParams, RandomParams, Scenario, WalkersParams};
 
-use crate::cli::{SynthWalkersArgs, WalkersScenarioArg};
 use crate::progress::FrameProgress;
+
+/// The walkers scenarios of the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum WalkersScenarioArg {
+    /// Two walkers crossing; the near one hides the far one for 5 frames.
+    Crossing,
+    /// Two walkers entering together (one blob) who then split.
+    GroupSplit,
+    /// Walkers entering from the borders at random times and speeds.
+    Random,
+}
+
+/// `sillage synth walkers`.
+#[derive(Debug, Args)]
+pub struct SynthWalkersArgs {
+    /// Output sequence folder (created): img1/000001.png ..., gt/gt.txt, seqinfo.ini.
+    #[arg(long, short, value_name = "DIR")]
+    pub out: PathBuf,
+    /// What the walkers do.
+    #[arg(long, value_enum, default_value_t = WalkersScenarioArg::Crossing)]
+    pub scenario: WalkersScenarioArg,
+    /// Number of walkers (random scenario only; the others have two).
+    #[arg(long)]
+    pub walkers: Option<usize>,
+    /// Number of frames, the 10 empty warm-up frames included (default 150).
+    #[arg(long)]
+    pub frames: Option<usize>,
+    /// Frame width, px.
+    #[arg(long, default_value_t = 320)]
+    pub width: usize,
+    /// Frame height, px.
+    #[arg(long, default_value_t = 240)]
+    pub height: usize,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
 
 /// Walkers the two-person scenarios have.
 const PAIR: usize = 2;

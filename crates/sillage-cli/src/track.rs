@@ -4,9 +4,11 @@
 //! states.
 
 use std::path::Path;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
 use serde::Serialize;
 use sillage::bedload::detector::BeadDetectorSources;
 use sillage::bedload::output::{BeadTrackKind, BeadTrackOutput};
@@ -17,14 +19,103 @@ use sillage::track::bedload::BedloadTrackerParams;
 use sillage::viz::OverlayStyle;
 use sillage::{DetectorConfig, FrameInput, Pipeline, PipelineConfig, TrackerConfig};
 
-use crate::cli::{BeadFormatArg, TrackBedloadArgs};
 use crate::overlay::{DetectionsByFrame, write_overlays};
 use crate::progress::FrameProgress;
+use crate::shared_args::{BeadDetectorArgs, ConfigFileArgs, JsonArg};
+
+/// The trackers of `sillage track bedload --tracker`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum BedloadTrackerArg {
+    /// Multi-model particle filter with the motion-state cue (the paper's method).
+    MmpfPlus,
+    /// Multi-model particle filter without the cue, one saltating state.
+    Mmpf,
+    /// One constant-velocity particle filter.
+    Pf,
+    /// Kalman IMM of the three linear motions.
+    Imm,
+    /// Deterministic association of the detections.
+    Det,
+}
+
+impl From<BedloadTrackerArg> for sillage::track::bedload::BedloadTrackerKind {
+    fn from(arg: BedloadTrackerArg) -> Self {
+        match arg {
+            BedloadTrackerArg::MmpfPlus => Self::MmpfPlus,
+            BedloadTrackerArg::Mmpf => Self::Mmpf,
+            BedloadTrackerArg::Pf => Self::Pf,
+            BedloadTrackerArg::Imm => Self::Imm,
+            BedloadTrackerArg::Det => Self::Det,
+        }
+    }
+}
+
+/// Output formats of bead trajectories.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BeadFormatArg {
+    /// CSV in the layout of BeadTracking's ground truth,
+    /// `frame,id,x,y,category,vx,vy,motion_state,spread_px` (1-based frames and pixels,
+    /// motion-state codes 0-3): what `sillage eval mot` compares with bead truth.
+    Beads,
+    /// CSV with trackpy column names then `class,motion_state,spread_px` (0-based, state
+    /// names).
+    Csv,
+    /// Apache Parquet with the CSV's columns.
+    Parquet,
+    /// HDF5, one dataset per column (needs the `hdf5` cargo feature).
+    Hdf5,
+}
+
+/// `sillage track bedload`.
+#[derive(Debug, Args)]
+pub struct TrackBedloadArgs {
+    /// Frames to detect the beads in (a folder, a quoted glob, a multi-page TIFF or a video),
+    /// instead of `--detections`.
+    #[arg(required_unless_present = "detections", conflicts_with_all = ["detections", "candidates"])]
+    pub input: Option<String>,
+    /// Detections CSV: `frame,x,y,class,score` (frames 0-based; class 0 black, 1 transparent).
+    #[arg(long, value_name = "FILE")]
+    pub detections: Option<PathBuf>,
+    /// Detector-confidence candidates (Eq. (1)), same layout: every response maximum above a
+    /// low threshold with its score. Without it, a missed bead is pulled towards the
+    /// unclaimed detections of its class.
+    #[arg(long, value_name = "FILE")]
+    pub candidates: Option<PathBuf>,
+    /// Trajectories to write; the format from `--format`, else from the extension: `.csv`
+    /// in BeadTracking's layout, `.parquet`, `.h5`.
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Output format (default: `beads` for `.csv`, else from the extension of --out).
+    #[arg(long, value_enum)]
+    pub format: Option<BeadFormatArg>,
+    /// `--config FILE` and `--set KEY=VALUE`: the parameters.
+    #[command(flatten)]
+    pub params: ConfigFileArgs,
+    /// Which tracker (overrides the config's `tracker`).
+    #[arg(long, value_enum)]
+    pub tracker: Option<BedloadTrackerArg>,
+    /// Random seed of the particles (overrides the config's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// The detector, when tracking frames.
+    #[command(flatten)]
+    pub detector: BeadDetectorArgs,
+    /// Also draw every frame with its detections and track tails (coloured by motion state,
+    /// with ids) into this folder, as `overlay_NNNNN.png`.
+    #[arg(long, value_name = "DIR", requires = "input")]
+    pub overlay: Option<PathBuf>,
+    /// Frames of history in each overlay tail.
+    #[arg(long, value_name = "FRAMES", default_value_t = 20)]
+    pub overlay_tail: u64,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 /// Defaults, then `--config`, then `--set`, then `--tracker` and `--seed`; validated.
 pub fn load_bedload_params(args: &TrackBedloadArgs) -> Result<BedloadTrackerParams> {
     let mut params: BedloadTrackerParams =
-        load_unvalidated(args.config.as_deref(), &args.overrides)?;
+        load_unvalidated(args.params.config.as_deref(), &args.params.overrides)?;
     if let Some(kind) = args.tracker {
         params.tracker = kind.into();
     }
@@ -157,7 +248,7 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
         ms_per_frame: 1e3 * elapsed / stats.frames.max(1) as f64,
         out: written.path.display().to_string(),
     };
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         eprintln!(

@@ -2,7 +2,10 @@
 //! on colour frames (motion blobs or `--detections` as births) or on detections alone;
 //! writes MOTChallenge results and, with `--model-weights`, the model weights πₘ per row.
 
+use std::path::PathBuf;
+
 use anyhow::Result;
+use clap::Args;
 use serde::Serialize;
 use sillage::io::MotResultsWriter;
 use sillage::pedestrian::immpf::{ImmpfRun, ModelWeightsWriter, Scene, mot_rows};
@@ -10,9 +13,61 @@ use sillage::pedestrian::input::frame_size_beside;
 use sillage::pedestrian::{ImmpfSettings, PedestrianInput};
 use sillage::track::immpf::ModelName;
 
-use crate::cli::TrackImmpfArgs;
 use crate::progress::FrameProgress;
+use crate::shared_args::{ConfigFileArgs, FrameSize, JsonArg};
 use sillage::overlay::PedestrianOverlays;
+
+/// `sillage track immpf`.
+#[derive(Debug, Args)]
+pub struct TrackImmpfArgs {
+    /// Colour frames (a folder, a quoted glob, a multi-page TIFF or a video); without them,
+    /// `--detections` alone are tracked.
+    #[arg(required_unless_present = "detections")]
+    pub input: Option<String>,
+    /// MOTChallenge detections (`frame,-1,left,top,width,height,score,...`): the birth
+    /// candidates instead of motion blobs; without frames, also the measurements.
+    #[arg(long, value_name = "FILE")]
+    pub detections: Option<PathBuf>,
+    /// Frame size `WxH` for detections alone (default: the `seqinfo.ini` of a MOTChallenge
+    /// sequence folder `SEQ/det/det.txt`).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<FrameSize>,
+    /// Ground plane (TOML: `[homography]` and `adult_height_m`, `adult_width_m`; written by
+    /// `sillage fit homography`): boxes sized by an adult's size at the foot point (§4).
+    /// Without it each tracker keeps the size of the blob or detection it was born on.
+    #[arg(long, value_name = "FILE")]
+    pub ground_plane: Option<PathBuf>,
+    /// Learned motion prior (JSON from `sillage fit motion-prior`), needed by MP.
+    #[arg(long, value_name = "FILE")]
+    pub motion_prior: Option<PathBuf>,
+    /// The competing models as the paper writes them: CA, CV, MP, CV_CA, CV_CA_MP,
+    /// CP_CV_CA, CP_CV_CA_MP, ... (default CV_CA).
+    #[arg(long, value_name = "MODELS")]
+    pub models: Option<String>,
+    /// MOTChallenge results to write (1-based frames).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Also write `frame,id,<model weights>` for every result row.
+    #[arg(long, value_name = "FILE")]
+    pub model_weights: Option<PathBuf>,
+    /// Also draw every frame with each person's box, the bar of its model weights and its
+    /// trajectory coloured by the dominant model (CP red, CV green, CA blue, MP magenta) into
+    /// this folder, as `overlay_NNNNN.png` (1-based frame number).
+    #[arg(long, value_name = "DIR", requires = "input")]
+    pub overlay: Option<PathBuf>,
+    /// `--config FILE` and `--set KEY=VALUE`: the parameters.
+    #[command(flatten)]
+    pub params: ConfigFileArgs,
+    /// Random seed of the particles.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Stop after this many frames.
+    #[arg(long, value_name = "N")]
+    pub max_frames: Option<usize>,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 /// What a run did (`--json`: as JSON on stdout).
 #[derive(Debug, Serialize)]
@@ -33,7 +88,11 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         .as_deref()
         .map(ModelName::parse_combination)
         .transpose()?;
-    let settings = ImmpfSettings::load(args.config.as_deref(), &args.overrides, models.as_deref())?;
+    let settings = ImmpfSettings::load(
+        args.params.config.as_deref(),
+        &args.params.overrides,
+        models.as_deref(),
+    )?;
     let params = &settings.tracker;
     let scene = Scene::load(args.ground_plane.as_deref(), args.motion_prior.as_deref())?;
     let size = match (args.size, &args.detections) {
@@ -90,7 +149,7 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         tracking_ms_per_frame: per_frame(run.tracking),
         out: args.out.display().to_string(),
     };
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         eprintln!(

@@ -7,7 +7,7 @@ use anyhow::Result;
 use sillage::io::{TableFormat, TrackFormat};
 use sillage::tables::{LoadedTracks, read_track_points};
 
-use crate::cli::TableFormatArg;
+use crate::shared_args::TableFormatArg;
 
 /// Reads `path` in `format`, or in the format its extension and first line tell; an empty
 /// table is an error.

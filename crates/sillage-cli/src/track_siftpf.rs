@@ -1,16 +1,48 @@
 //! `sillage track siftpf`: surveillance objects found by motion detection and followed by
 //! their SIFT features' particle filters (Souded et al. 2011); writes MOTChallenge results.
 
+use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::Result;
+use clap::Args;
 use serde::Serialize;
 use sillage::io::MotResultsWriter;
 use sillage::pedestrian::siftpf::track_siftpf;
 use sillage::pedestrian::{GroundPlaneFile, SiftPfSettings};
 
-use crate::cli::TrackSiftpfArgs;
 use crate::progress::FrameProgress;
+use crate::shared_args::{ConfigFileArgs, JsonArg};
+
+/// `sillage track siftpf`.
+#[derive(Debug, Args)]
+pub struct TrackSiftpfArgs {
+    /// Colour frames (a folder, a quoted glob, a multi-page TIFF or a video).
+    pub input: String,
+    /// MOTChallenge results to write (1-based frames).
+    #[arg(long, short, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Feature selection, the paper's configurations of §3.1.1: whole-object (1),
+    /// detection-order (2), reliability (3, the default).
+    #[arg(long, value_name = "NAME")]
+    pub selection: Option<String>,
+    /// Ground plane (TOML with `[homography]`, from `sillage fit homography`): sizes and
+    /// speeds learned in metres for resuming occluded objects (§2.4); pixels without it.
+    #[arg(long, value_name = "FILE")]
+    pub ground_plane: Option<PathBuf>,
+    /// `--config FILE` and `--set KEY=VALUE`: the parameters.
+    #[command(flatten)]
+    pub params: ConfigFileArgs,
+    /// Random seed of the particles.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Stop after this many frames.
+    #[arg(long, value_name = "N")]
+    pub max_frames: Option<usize>,
+    /// `--json`: a machine-readable summary on stdout.
+    #[command(flatten)]
+    pub json: JsonArg,
+}
 
 /// What a run did (`--json`: as JSON on stdout).
 #[derive(Debug, Serialize)]
@@ -27,8 +59,8 @@ struct Summary {
 /// `sillage track siftpf FRAMES --out FILE`.
 pub fn run(args: &TrackSiftpfArgs) -> Result<()> {
     let settings = SiftPfSettings::load(
-        args.config.as_deref(),
-        &args.overrides,
+        args.params.config.as_deref(),
+        &args.params.overrides,
         args.selection.as_deref(),
     )?;
     let homography = args
@@ -66,7 +98,7 @@ pub fn run(args: &TrackSiftpfArgs) -> Result<()> {
         tracking_ms_per_frame: per_frame(run.tracking),
         out: args.out.display().to_string(),
     };
-    if args.json {
+    if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         eprintln!(

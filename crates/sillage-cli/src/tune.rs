@@ -3,13 +3,34 @@
 //! page until interrupted.
 
 use std::net::TcpListener;
+use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
+use clap::Args;
 use sillage::tune::{TuneSession, load_frames, serve_session};
 
-use crate::cli::TuneArgs;
 use crate::progress::FrameProgress;
 use crate::ptv::load_config;
+use crate::shared_args::ConfigArgs;
+
+/// `sillage tune`.
+#[derive(Debug, Args)]
+pub struct TuneArgs {
+    /// Frames: a folder, a quoted glob pattern, a multi-page TIFF or a video.
+    pub input: String,
+    /// The configuration the page starts from (as `sillage ptv`'s).
+    #[command(flatten)]
+    pub config: ConfigArgs,
+    /// Where "save" writes the configuration (TOML, for `sillage ptv --config`).
+    #[arg(long, value_name = "FILE", default_value = "sillage.toml")]
+    pub save: PathBuf,
+    /// Frames loaded for tuning: the first N of the sequence, kept in memory.
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    pub max_frames: usize,
+    /// Port on 127.0.0.1 (0: a free one); the address is printed on the first line of stdout.
+    #[arg(long, default_value_t = 0)]
+    pub port: u16,
+}
 
 /// `sillage tune`: loads the frames, then serves the page until interrupted.
 pub fn run(args: &TuneArgs) -> Result<()> {
