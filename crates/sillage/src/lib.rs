@@ -1,7 +1,17 @@
 //! sillage: follow many moving objects through image sequences.
 //!
-//! This facade re-exports the toolkit's crates and builds a whole pipeline from one
-//! [`PipelineConfig`]. It is the only crate that knows every detector and tracker.
+//! This facade is the composition root: it re-exports the toolkit's crates, knows every
+//! detector and tracker, and holds everything the command line computes, so that Rust users,
+//! the Python package and any other runner reach the same code:
+//! - [`Pipeline`] runs PTV or the bedload trackers with their detector from one
+//!   [`PipelineConfig`], streaming, from frames or detection tables;
+//! - [`track_source`] / [`detect_source`] run any of the four trackers (PTV, bedload, IMM-PF,
+//!   SIFT-PF) or three detectors (blob, bead, motion) on a frame source ([`tracking`]);
+//! - [`pedestrian`], [`bedload`]: the pedestrian and bedload runs, their inputs, settings,
+//!   fits and outputs; [`experiments`]: each paper's tables, medians over seeds;
+//! - [`evaluate`], [`tables`]: truth and tracks of every format, scored as TrackEval does;
+//! - [`toml_config`]: every command's settings, read once and validated
+//!   ([`toml_config::load`]).
 //!
 //! ```no_run
 //! use sillage::{Pipeline, PipelineConfig};
