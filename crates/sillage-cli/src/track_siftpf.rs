@@ -86,14 +86,14 @@ pub fn run(args: &TrackSiftpfArgs) -> Result<()> {
     }
     let run = run?;
     let mut writer = MotResultsWriter::create(&args.out)?;
-    writer.push(&run.rows)?;
+    writer.push(&run.rows())?;
     writer.finish()?;
     let per_frame = |d: Duration| 1e3 * d.as_secs_f64() / run.frames as f64;
     let summary = Summary {
         selection: settings.tracker.selection.label().to_string(),
         frames: run.frames,
         tracks: run.track_count(),
-        rows: run.rows.len(),
+        rows: run.estimates.len(),
         ms_per_frame: per_frame(run.total),
         tracking_ms_per_frame: per_frame(run.tracking),
         out: args.out.display().to_string(),

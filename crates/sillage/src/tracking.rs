@@ -137,9 +137,9 @@ pub fn track_source(
                 &mut |_| on_frame(),
             )?;
             let points: Vec<TrackPoint> = run
-                .rows
+                .estimates
                 .iter()
-                .map(|row| person_point(row.frame, row.id.unwrap_or_default(), row.bbox(), None))
+                .map(|e| person_point(e.frame, e.id, e.bbox, None))
                 .collect();
             sink.accept(&points)?;
             Ok(run.frames)

@@ -307,10 +307,7 @@ impl RunOf<'_> {
             self.max_frames,
             on_frame,
         )?;
-        let boxes = run.rows.iter().filter_map(|r| {
-            let bbox = r.bbox();
-            Some((r.frame, r.id?, bbox))
-        });
+        let boxes = run.estimates.iter().map(|e| (e.frame, e.id, e.bbox));
         let data = self.sequence.truth.data(boxes, run.frames)?;
         let params = MotParams::default();
         Ok(Tally {

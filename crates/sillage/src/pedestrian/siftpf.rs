@@ -26,8 +26,8 @@ pub fn detected_objects(blobs: &mut Vec<MotionBlob>) -> Vec<DetectedObject> {
 
 /// What tracking one sequence gave.
 pub struct SiftPfRun {
-    /// Result rows, sorted by frame then identity (0-based frames).
-    pub rows: Vec<MotRow>,
+    /// The reported boxes, sorted by frame then identity (0-based frames).
+    pub estimates: Vec<SiftPfEstimate>,
     /// Frames tracked.
     pub frames: u64,
     /// Time in the tracker (SIFT, features, association), excluding decoding and motion
@@ -38,9 +38,17 @@ pub struct SiftPfRun {
 }
 
 impl SiftPfRun {
-    /// The number of distinct track identities in the rows.
+    /// The estimates as MOTChallenge result rows (confidence 1).
+    pub fn rows(&self) -> Vec<MotRow> {
+        self.estimates
+            .iter()
+            .map(|e| MotRow::result(e.frame, e.id, &e.bbox))
+            .collect()
+    }
+
+    /// The number of distinct track identities in the estimates.
     pub fn track_count(&self) -> usize {
-        let mut ids: Vec<u64> = self.rows.iter().filter_map(|r| r.id).collect();
+        let mut ids: Vec<u64> = self.estimates.iter().map(|e| e.id).collect();
         ids.sort_unstable();
         ids.dedup();
         ids.len()
@@ -98,10 +106,7 @@ pub fn track_siftpf(
     }
     estimates.sort_by_key(|e| (e.frame, e.id));
     Ok(SiftPfRun {
-        rows: estimates
-            .iter()
-            .map(|e| MotRow::result(e.frame, e.id, &e.bbox))
-            .collect(),
+        estimates,
         frames: count,
         tracking,
         total: started.elapsed(),
