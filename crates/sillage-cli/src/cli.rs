@@ -6,6 +6,7 @@ use crate::bench::BenchPtvArgs;
 use crate::bench_bedload::BenchBedloadArgs;
 use crate::bench_eulerian::BenchEulerianArgs;
 use crate::bench_immpf::BenchImmpfArgs;
+use crate::bench_ptv_accuracy::BenchPtvAccuracyArgs;
 use crate::bench_siftpf::BenchSiftpfArgs;
 use crate::demo::DemoArgs;
 use crate::demo_bedload::DemoBedloadArgs;
@@ -139,6 +140,11 @@ pub enum DemoKind {
 pub enum BenchCommand {
     /// Detection and tracking time per frame on synthetic vortex frames.
     Ptv(BenchPtvArgs),
+    /// PTV accuracy (true / false recoveries) on a family of synthetic flows, particle sizes,
+    /// densities, displacements and noise levels: the defaults against the old defaults and
+    /// the best of a grid search per case, on the half of the family defaults were not chosen
+    /// on (--half report, the default).
+    PtvAccuracy(BenchPtvAccuracyArgs),
     /// `sillage eulerian`'s speed and peak memory on generated track tables of growing length.
     Eulerian(BenchEulerianArgs),
     /// The MMPF+ paper's evaluation: Table 1 (the five bedload trackers) and the τ_t sweep of

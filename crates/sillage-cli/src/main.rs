@@ -7,6 +7,7 @@ mod bench;
 mod bench_bedload;
 mod bench_eulerian;
 mod bench_immpf;
+mod bench_ptv_accuracy;
 mod bench_siftpf;
 mod cli;
 mod demo;
@@ -49,6 +50,7 @@ fn main() {
             None => demo::run(&a),
         },
         cli::Command::Bench(cli::BenchCommand::Ptv(a)) => bench::run_ptv(&a),
+        cli::Command::Bench(cli::BenchCommand::PtvAccuracy(a)) => bench_ptv_accuracy::run(&a),
         cli::Command::Bench(cli::BenchCommand::Eulerian(a)) => bench_eulerian::run(&a),
         cli::Command::Bench(cli::BenchCommand::Bedload(a)) => bench_bedload::run(&a),
         cli::Command::Bench(cli::BenchCommand::Immpf(a)) => bench_immpf::run(&a),

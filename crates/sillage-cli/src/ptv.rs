@@ -64,6 +64,11 @@ pub fn run(args: &PtvArgs) -> Result<()> {
     if let Some(used) = run.background_frames() {
         eprintln!("background initialised from the mean of the first {used} frames");
     }
+    if let Some(calibration) = run.calibration()
+        && calibration.measured.is_some()
+    {
+        eprintln!("{calibration}");
+    }
     let mut progress = FrameProgress::new(run.frame_count(), "tracking");
     let outcome = run.run_to_file(&args.out, format, &mut |report| progress.frame(report));
     progress.finish();

@@ -73,7 +73,14 @@ fn api_detects_as_the_library_and_saves_a_config_ptv_reads() {
         (Some(256), Some(192))
     );
     let mut config = state["config"].clone();
-    assert_eq!(config["detector"]["scale_px"], 2.0);
+    // The page starts from the scale and polarity measured on the first frame (σ = 2 px
+    // particles, bright), not from "auto".
+    let sigma = state["measured"]["measured"]["sigma_px"].as_f64().unwrap();
+    assert!((1.7..2.5).contains(&sigma), "{state}");
+    let scale = config["detector"]["scale_px"].as_f64().unwrap();
+    let expected = sillage::detect::auto_scale_px(sigma);
+    assert!((scale - expected).abs() < 0.01, "{scale} vs {expected}");
+    assert_eq!(config["detector"]["polarity"], "bright");
 
     let (status, reply) = call(
         &server,

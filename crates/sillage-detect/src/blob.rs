@@ -8,6 +8,94 @@ use sillage_image::{
     median_mad, refine_peak,
 };
 
+use crate::matched_refine::MatchedRefiner;
+use crate::particle_size::{ParticleImages, measure_particle_images};
+
+/// The blob scale δ: measured from the first frame, or given in px.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Scale {
+    /// δ from the particle images' σ measured on the first frame ([`measure_particle_images`],
+    /// [`auto_scale_px`]); `"auto"` in TOML, the default.
+    #[default]
+    #[serde(with = "auto_keyword")]
+    Auto,
+    /// δ in px, in `(0, 50]`.
+    Px(f64),
+}
+
+/// The particles' polarity: measured from the first frame, or given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PolarityChoice {
+    /// Measured on the first frame with the particle size ([`measure_particle_images`]); the
+    /// default.
+    #[default]
+    Auto,
+    /// Bright particles on a dark background.
+    Bright,
+    /// Dark particles on a bright background (TracTrac's `peak_minima = 1`).
+    Dark,
+}
+
+impl PolarityChoice {
+    /// The polarity given, `None` for `Auto`.
+    pub fn given(self) -> Option<Polarity> {
+        match self {
+            PolarityChoice::Auto => None,
+            PolarityChoice::Bright => Some(Polarity::Bright),
+            PolarityChoice::Dark => Some(Polarity::Dark),
+        }
+    }
+}
+
+impl From<Polarity> for PolarityChoice {
+    fn from(polarity: Polarity) -> Self {
+        match polarity {
+            Polarity::Bright => PolarityChoice::Bright,
+            Polarity::Dark => PolarityChoice::Dark,
+        }
+    }
+}
+
+/// `Scale::Auto` as the string `"auto"`.
+mod auto_keyword {
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+
+    pub fn serialize<S: Serializer>(serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str("auto")
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<(), D::Error> {
+        match String::deserialize(deserializer)?.as_str() {
+            "auto" => Ok(()),
+            other => Err(D::Error::custom(format!(
+                "expected \"auto\" or a number of px, found \"{other}\""
+            ))),
+        }
+    }
+}
+
+/// The automatic blob scale is `δ = √(AUTO_SCALE_BASE_PX · σ̂)`, the geometric mean of this
+/// and the measured σ̂ of the particle images (px).
+///
+/// A blob of std σ answers most to δ ≈ σ (best localisation of an isolated particle), but
+/// neighbours then merge; a smaller δ resolves them. Between the two, a δ that grows more
+/// slowly than σ did best. Tuned on the **tune** half of the `bench ptv-accuracy` family
+/// (`tests/ptv_family_tuning.rs`; 12 cases, 512², 10 frames), mean true / false recoveries:
+/// δ = σ̂ 53.5 % / 20.2 %, 0.7σ̂ 56.1 / 18.0, √(0.8σ̂) **57.7 / 15.2**, √(1.0σ̂) 56.9 / 15.2,
+/// √(1.2σ̂) 55.2 / 15.3, √(1.5σ̂) 52.3 / 16.5 (old fixed δ = 2: 42.2 / 20.8). On the report
+/// half, never used to choose it: see `docs/ptv.md`.
+pub const AUTO_SCALE_BASE_PX: f64 = 0.8;
+
+/// The automatic blob scale for particle images of measured std `sigma_px`
+/// (see [`AUTO_SCALE_BASE_PX`]), px.
+pub fn auto_scale_px(sigma_px: f64) -> f64 {
+    (AUTO_SCALE_BASE_PX * sigma_px)
+        .sqrt()
+        .clamp(MIN_AUTO_SCALE_PX, MAX_SCALE_PX)
+}
+
 /// The band-pass filter applied before peak finding (TracTrac's `peak_conv`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -78,6 +166,22 @@ pub enum Threshold {
     Fixed(f64),
 }
 
+impl Threshold {
+    /// The threshold this rule gives on the band-passed image `filtered` (`samples`: a reused
+    /// buffer); `None` when the image is empty.
+    pub fn of(&self, filtered: &GrayImage, samples: &mut Vec<f32>) -> Option<f32> {
+        match *self {
+            Threshold::Fixed(value) => Some(value as f32),
+            Threshold::Auto { std_factor } => {
+                mean_std(filtered).map(|s| (s.mean + std_factor * s.std) as f32)
+            }
+            Threshold::Noise { k } => {
+                median_mad(filtered, samples).map(|s| (s.median + k * s.sigma) as f32)
+            }
+        }
+    }
+}
+
 /// The `k` of the default [`Threshold::Noise`].
 pub const DEFAULT_NOISE_K: f64 = 4.0;
 
@@ -94,15 +198,17 @@ impl Default for Threshold {
 pub struct BlobParams {
     /// Band-pass filter. Default DoG.
     pub filter: BlobFilter,
-    /// Blob scale δ in px, in `(0, 50]` (`peak_conv_size`). Default 2.0.
-    pub scale_px: f64,
+    /// Blob scale δ in px, in `(0, 50]` (`peak_conv_size`), or `"auto"` (the default):
+    /// measured from the first frame, see [`Scale::Auto`].
+    pub scale_px: Scale,
     /// Half-width n of the `(2n+1)²` local-maximum window, in `1..=10` (`peak_neigh`).
     /// Default 1 (3×3).
     pub neighbourhood: usize,
     /// Detection threshold. Default [`Threshold::Noise`], median + 4·σ̂ of the filtered image.
     pub threshold: Threshold,
-    /// Bright or dark objects (`peak_minima`). Default bright.
-    pub polarity: Polarity,
+    /// Bright or dark objects (`peak_minima`), or `"auto"` (the default): measured from the
+    /// first frame.
+    pub polarity: PolarityChoice,
     /// Sub-pixel fit (`peak_subpix`). Default Gaussian.
     pub subpixel: SubpixelFit,
     /// Region searched; detections keep full-frame coordinates (TracTrac's Python reports
@@ -114,10 +220,10 @@ impl Default for BlobParams {
     fn default() -> Self {
         Self {
             filter: BlobFilter::Dog,
-            scale_px: 2.0,
+            scale_px: Scale::Auto,
             neighbourhood: 1,
             threshold: Threshold::default(),
-            polarity: Polarity::Bright,
+            polarity: PolarityChoice::Auto,
             subpixel: SubpixelFit::Gaussian,
             roi: None,
         }
@@ -131,11 +237,13 @@ impl BlobParams {
     /// Errors naming the key and its allowed range when a value is out of range. The ROI is
     /// checked against the frame size at detection time.
     pub fn validate(&self) -> Result<()> {
-        if !(self.scale_px.is_finite() && self.scale_px > 0.0 && self.scale_px <= MAX_SCALE_PX) {
+        if let Scale::Px(scale) = self.scale_px
+            && !(scale.is_finite() && scale > 0.0 && scale <= MAX_SCALE_PX)
+        {
             return Err(Error::parameter(
                 "scale_px",
-                self.scale_px,
-                format!("must be a number in (0, {MAX_SCALE_PX}] px"),
+                scale,
+                format!("must be a number in (0, {MAX_SCALE_PX}] px, or \"auto\""),
             ));
         }
         if !(1..=MAX_NEIGHBOURHOOD).contains(&self.neighbourhood) {
@@ -195,7 +303,9 @@ enum BandPass {
 #[derive(Debug, Clone)]
 pub struct BlobDetector {
     params: BlobParams,
-    band_pass: BandPass,
+    /// `None` until the scale and polarity are known (measured on the first frame when auto).
+    resolved: Option<Resolved>,
+    measured: Option<ParticleImages>,
     cropped: GrayImage,
     filtered: GrayImage,
     finder: PeakFinder<Detection>,
@@ -204,17 +314,20 @@ pub struct BlobDetector {
 }
 
 impl BlobDetector {
-    /// A detector with validated `params`.
+    /// A detector with validated `params`. With `"auto"` scale or polarity, they are measured
+    /// on the first frame detected (or given to [`BlobDetector::calibrate`]).
     pub fn new(params: BlobParams) -> Result<Self> {
         params.validate()?;
-        let band_pass = match params.filter {
-            BlobFilter::Dog => BandPass::Dog(DogFilter::new(params.scale_px)?),
-            BlobFilter::Log => BandPass::Log(LogFilter::new(params.scale_px)?),
-            BlobFilter::None => BandPass::Identity,
+        let resolved = match (params.scale_px, params.polarity.given()) {
+            (Scale::Px(scale), Some(polarity)) => {
+                Some(Resolved::new(&params, scale, polarity, None)?)
+            }
+            _ => None,
         };
         Ok(Self {
             params,
-            band_pass,
+            resolved,
+            measured: None,
             cropped: GrayImage::default(),
             filtered: GrayImage::default(),
             finder: PeakFinder::default(),
@@ -237,12 +350,142 @@ impl BlobDetector {
     pub fn last_threshold(&self) -> Option<f32> {
         self.last_threshold
     }
+
+    /// Measures the particle images on `image` (the ROI of a pre-processed frame, as
+    /// [`Detector::detect`] sees it) when the scale or polarity is `"auto"` and not yet
+    /// measured; the values given explicitly are kept. Errors with "no particles found" when
+    /// the frame has none to measure. Detection calls it on its first frame.
+    pub fn calibrate(&mut self, image: &GrayImage) -> Result<()> {
+        if self.resolved.is_some() {
+            return Ok(());
+        }
+        let input = match &self.params.roi {
+            Some(roi) => {
+                roi.crop(image, &mut self.cropped)?;
+                &self.cropped
+            }
+            None => image,
+        };
+        let measured = measure_particle_images(input)?;
+        let (scale, particle_sigma) = match self.params.scale_px {
+            Scale::Px(scale) => (scale, None),
+            Scale::Auto => (auto_scale_px(measured.sigma_px), Some(measured.sigma_px)),
+        };
+        let polarity = self.params.polarity.given().unwrap_or(measured.polarity);
+        self.resolved = Some(Resolved::new(
+            &self.params,
+            scale,
+            polarity,
+            particle_sigma,
+        )?);
+        self.measured = Some(measured);
+        Ok(())
+    }
+
+    /// The scale and polarity in use and what was measured to choose them; `None` until
+    /// they are known (an `"auto"` detector before its first frame).
+    pub fn calibration(&self) -> Option<Calibration> {
+        self.resolved.as_ref().map(|r| Calibration {
+            scale_px: r.scale_px,
+            polarity: r.polarity,
+            measured: self.measured,
+        })
+    }
+}
+
+/// The scale and polarity a [`BlobDetector`] runs with, and the measurement behind them when
+/// either was `"auto"` (for run summaries and track-file headers).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Calibration {
+    /// The blob scale δ in use, px.
+    pub scale_px: f64,
+    /// The polarity in use.
+    pub polarity: Polarity,
+    /// The particle images measured on the first frame; `None` when nothing was `"auto"`.
+    pub measured: Option<ParticleImages>,
+}
+
+/// Smallest δ an automatic scale takes, px (the DoG's narrow Gaussian is then 0.4 px).
+const MIN_AUTO_SCALE_PX: f64 = 0.5;
+
+impl std::fmt::Display for Calibration {
+    /// One line for run summaries: the measurement, then the values in use.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let polarity = |p: Polarity| match p {
+            Polarity::Bright => "bright",
+            Polarity::Dark => "dark",
+        };
+        if let Some(m) = &self.measured {
+            write!(
+                f,
+                "particle images measured on the first frame: σ {:.2} px, {} ({} blobs; {} of \
+                 the other polarity) → ",
+                m.sigma_px,
+                polarity(m.polarity),
+                m.blobs,
+                m.blobs_other_polarity
+            )?;
+        }
+        write!(
+            f,
+            "detector.scale_px = {:.2}, detector.polarity = {}",
+            self.scale_px,
+            polarity(self.polarity)
+        )
+    }
+}
+
+/// The scale and polarity in use, with the band-pass filter built for them.
+#[derive(Debug, Clone)]
+struct Resolved {
+    scale_px: f64,
+    polarity: Polarity,
+    band_pass: BandPass,
+    /// Re-fits isolated particles at their own scale, when the scale is automatic and smaller
+    /// than the particles.
+    refiner: Option<MatchedRefiner>,
+}
+
+/// The matched-scale re-fit runs when the measured σ exceeds the automatic δ by this factor.
+const REFINE_ABOVE: f64 = 1.2;
+
+impl Resolved {
+    /// The filters for `scale_px`; `particle_sigma_px` (measured, for an automatic scale)
+    /// adds the matched-scale re-fit of isolated particles when it is well above the scale.
+    fn new(
+        params: &BlobParams,
+        scale_px: f64,
+        polarity: Polarity,
+        particle_sigma_px: Option<f64>,
+    ) -> Result<Self> {
+        let band_pass = match params.filter {
+            BlobFilter::Dog => BandPass::Dog(DogFilter::new(scale_px)?),
+            BlobFilter::Log => BandPass::Log(LogFilter::new(scale_px)?),
+            BlobFilter::None => BandPass::Identity,
+        };
+        let refiner = match (params.filter, particle_sigma_px) {
+            (BlobFilter::Dog, Some(sigma)) if sigma > REFINE_ABOVE * scale_px => {
+                Some(MatchedRefiner::new(sigma.min(MAX_SCALE_PX))?)
+            }
+            _ => None,
+        };
+        Ok(Self {
+            scale_px,
+            polarity,
+            band_pass,
+            refiner,
+        })
+    }
 }
 
 impl Detector for BlobDetector {
     fn detect(&mut self, image: &GrayImage, out: &mut Vec<Detection>) -> Result<()> {
         out.clear();
         self.last_threshold = None;
+        self.calibrate(image)?;
+        let Some(resolved) = &mut self.resolved else {
+            return Ok(());
+        };
         let (input, x0, y0) = match &self.params.roi {
             Some(roi) => {
                 roi.crop(image, &mut self.cropped)?;
@@ -250,8 +493,8 @@ impl Detector for BlobDetector {
             }
             None => (image, 0, 0),
         };
-        let polarity = self.params.polarity;
-        match &mut self.band_pass {
+        let polarity = resolved.polarity;
+        match &mut resolved.band_pass {
             BandPass::Dog(dog) => dog.apply(input, polarity, &mut self.filtered),
             BandPass::Log(log) => log.apply(input, polarity, &mut self.filtered),
             BandPass::Identity => {
@@ -267,20 +510,13 @@ impl Detector for BlobDetector {
                 }
             }
         }
-        let threshold = match self.params.threshold {
-            Threshold::Fixed(value) => value as f32,
-            Threshold::Auto { std_factor } => match mean_std(&self.filtered) {
-                Some(s) => (s.mean + std_factor * s.std) as f32,
-                None => return Ok(()),
-            },
-            Threshold::Noise { k } => match median_mad(&self.filtered, &mut self.samples) {
-                Some(s) => (s.median + k * s.sigma) as f32,
-                None => return Ok(()),
-            },
+        let Some(threshold) = self.params.threshold.of(&self.filtered, &mut self.samples) else {
+            return Ok(());
         };
         self.last_threshold = Some(threshold);
         let filtered = &self.filtered;
         let subpixel = self.params.subpixel;
+
         // Peaks are at least one pixel inside the frame, so their 3×3 neighbourhood is too and
         // the fit always has a result; the integer position is only a formal fallback. Each
         // peak is fitted as soon as it is found, its rows still in cache, in peak order.
@@ -298,6 +534,18 @@ impl Detector for BlobDetector {
             },
             out,
         );
+        if let Some(refiner) = &mut resolved.refiner {
+            let (rule, samples) = (self.params.threshold, &mut self.samples);
+            let offset = (x0 as f64, y0 as f64);
+            refiner.refine(
+                input,
+                polarity,
+                subpixel,
+                offset,
+                |m| rule.of(m, samples),
+                out,
+            );
+        }
         Ok(())
     }
 }

@@ -36,11 +36,17 @@
 
 pub mod bead;
 pub mod blob;
+mod matched_refine;
 pub mod motion;
+pub mod particle_size;
 pub mod preprocess;
 
 pub use bead::{BeadDetections, BeadDetector, BeadGeometry, BeadParams};
-pub use blob::{BlobDetector, BlobFilter, BlobParams, DEFAULT_NOISE_K, Threshold};
+pub use blob::{
+    AUTO_SCALE_BASE_PX, BlobDetector, BlobFilter, BlobParams, Calibration, DEFAULT_NOISE_K,
+    PolarityChoice, Scale, Threshold, auto_scale_px,
+};
 pub use motion::{MotionBlob, MotionDetector, MotionParams};
+pub use particle_size::{ParticleImages, measure_particle_images};
 pub use preprocess::{BackgroundParams, PreprocessParams, Preprocessor};
 pub use sillage_image::{MedianSize, Polarity, Roi, SubpixelFit};

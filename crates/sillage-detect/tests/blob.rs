@@ -142,14 +142,21 @@ fn dark_polarity_finds_dark_spots() {
     let spots = grid(192, 192, -0.5, &mut rng);
     let image = render(192, 192, 0.8, &spots, 1.2, 0.0, &mut rng);
     let dark = BlobParams {
-        polarity: Polarity::Dark,
+        polarity: Polarity::Dark.into(),
         ..BlobParams::default()
     };
     let (matched, err) = score(&spots, &detect(dark, &image));
     assert_eq!(matched, spots.len());
     assert!(err < 0.05, "mean error {err} px");
+    // The default measures the polarity and finds them too.
+    let (matched_auto, _) = score(&spots, &detect(BlobParams::default(), &image));
+    assert_eq!(matched_auto, spots.len());
     // Looking for bright blobs instead finds none of them.
-    let (matched_bright, _) = score(&spots, &detect(BlobParams::default(), &image));
+    let bright = BlobParams {
+        polarity: Polarity::Bright.into(),
+        ..BlobParams::default()
+    };
+    let (matched_bright, _) = score(&spots, &detect(bright, &image));
     assert_eq!(matched_bright, 0);
 }
 
@@ -177,14 +184,14 @@ fn validate_rejects_bad_values_naming_the_key() {
     let cases = [
         (
             BlobParams {
-                scale_px: 0.0,
+                scale_px: sillage_detect::Scale::Px(0.0),
                 ..BlobParams::default()
             },
             "scale_px",
         ),
         (
             BlobParams {
-                scale_px: 51.0,
+                scale_px: sillage_detect::Scale::Px(51.0),
                 ..BlobParams::default()
             },
             "scale_px",

@@ -47,8 +47,8 @@ pub use bedload::{
 pub use noise::{Noise, NoiseKind};
 pub use render::render_spots;
 pub use vortex::{
-    DisplacementStats, SyntheticFrame, TruthFrame, VortexFlow, VortexParams, VortexSequence,
-    VortexTruth, displacement_stats, p_inverse, vortex_map,
+    DisplacementStats, FlowField, FlowKind, SyntheticFrame, TruthFrame, VortexFlow, VortexParams,
+    VortexSequence, VortexTruth, displacement_stats, p_inverse, vortex_map,
 };
 pub use walkers::{
     CrossingParams, GroupSplitParams, RandomParams, Scenario, WalkerTruth, WalkersFrame,

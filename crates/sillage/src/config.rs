@@ -186,7 +186,7 @@ mod tests {
         config.set("tracker.motion_av = 4").unwrap();
         config.set("detector.threshold.fixed=0.015").unwrap();
         config.set("detector.subpixel=quadratic").unwrap();
-        assert_eq!(blob(&config).scale_px, 3.5);
+        assert_eq!(blob(&config).scale_px, sillage_detect::Scale::Px(3.5));
         assert_eq!(blob(&config).threshold, Threshold::Fixed(0.015));
         let TrackerConfig::Ptv(ptv) = &config.tracker else {
             panic!("not PTV: {:?}", config.tracker);

@@ -4,7 +4,7 @@
 //! a tracking run sees.
 
 use sillage_core::{Detection, Detector, Error, GrayImage, Result};
-use sillage_detect::blob::BlobDetector;
+use sillage_detect::blob::{BlobDetector, Calibration};
 use sillage_detect::preprocess::Preprocessor;
 use sillage_detect::{BeadDetections, BeadDetector};
 use sillage_io::Frame;
@@ -104,7 +104,12 @@ impl DetectionStage {
             &frame.image
         };
         match &mut self.detector {
-            AnyDetector::Blob(detector) => detector.detect(image, out),
+            AnyDetector::Blob(detector) => {
+                detector
+                    .calibrate(image)
+                    .map_err(|e| Error::frame(&frame.path, frame.index, e.to_string()))?;
+                detector.detect(image, out)
+            }
             AnyDetector::Bead(detector, beads) => {
                 detect_frame(detector, frame, image, beads)?;
                 out.clear();
@@ -112,6 +117,42 @@ impl DetectionStage {
                 out.extend_from_slice(&beads.transparent);
                 Ok(())
             }
+        }
+    }
+
+    /// Measures the particle images on `frame` for a blob detector with an `"auto"` scale or
+    /// polarity, before any detection (so that a run can record them in its output header);
+    /// the pre-processing state (background model) is not advanced. Nothing to do for other
+    /// detectors, or once measured. Errors name the frame when it has no particles to measure.
+    pub fn calibrate(&mut self, frame: &Frame) -> Result<()> {
+        let AnyDetector::Blob(detector) = &mut self.detector else {
+            return Ok(());
+        };
+        if detector.calibration().is_some() {
+            return Ok(());
+        }
+        let mut preprocessed = GrayImage::default();
+        let image = if self.preprocessing {
+            self.preprocessor.clone().process(
+                &frame.image,
+                self.mask.as_ref(),
+                &mut preprocessed,
+            )?;
+            &preprocessed
+        } else {
+            &frame.image
+        };
+        detector
+            .calibrate(image)
+            .map_err(|e| Error::frame(&frame.path, frame.index, e.to_string()))
+    }
+
+    /// The blob detector's scale and polarity in use and what was measured to choose them
+    /// (`None` for other detectors, or before an `"auto"` one has seen a frame).
+    pub fn calibration(&self) -> Option<Calibration> {
+        match &self.detector {
+            AnyDetector::Blob(detector) => detector.calibration(),
+            AnyDetector::Bead(..) => None,
         }
     }
 

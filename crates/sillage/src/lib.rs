@@ -42,6 +42,7 @@ pub mod pedestrian;
 pub mod pipeline;
 pub mod plots;
 pub mod process_memory;
+pub mod ptv_accuracy_bench;
 pub mod ptv_bench;
 pub mod ptv_run;
 pub mod tables;

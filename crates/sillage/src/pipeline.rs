@@ -6,6 +6,7 @@ use sillage_core::{
     Detection, DiscardSink, Error, FrameIndex, FrameObservations, Result, TrackPoint, TrackSink,
     Tracker,
 };
+use sillage_detect::blob::Calibration;
 use sillage_io::Frame;
 use sillage_track::bedload::{BedloadStats, BedloadTracker};
 use sillage_track::ptv::{PassDirection, PtvTracker};
@@ -97,6 +98,9 @@ pub struct RunSummary {
     pub detect_ms_per_frame: f64,
     /// Mean wall time of tracking per frame, ms.
     pub track_ms_per_frame: f64,
+    /// The blob detector's scale and polarity and, when `"auto"`, what was measured on the
+    /// first frame to choose them; `None` for other detectors.
+    pub detector: Option<Calibration>,
 }
 
 /// A configured detector and tracker, fed one frame at a time.
@@ -194,6 +198,18 @@ impl Pipeline {
             used += self.stage.prime_background(std::iter::once(&frame.image))?;
         }
         Ok(used)
+    }
+
+    /// Measures the particle images on `frame` before the run when the blob detector's scale
+    /// or polarity is `"auto"` (see [`DetectionStage::calibrate`]); otherwise the first frame
+    /// detected is measured.
+    pub fn calibrate(&mut self, frame: &Frame) -> Result<()> {
+        self.stage.calibrate(frame)
+    }
+
+    /// The blob detector's scale and polarity in use and what was measured to choose them.
+    pub fn calibration(&self) -> Option<Calibration> {
+        self.stage.calibration()
     }
 
     /// Pre-processes and detects one frame; the detections stay in `self.detections`.
@@ -302,6 +318,7 @@ impl Pipeline {
         self.tracker.as_tracker().finish(&mut counting)?;
         totals.points = counting.points;
         totals.tracks = counting.track_ids_seen;
+        totals.detector = self.stage.calibration();
         if totals.frames > 0 {
             totals.detect_ms_per_frame = detect_time.as_secs_f64() * 1e3 / totals.frames as f64;
             totals.track_ms_per_frame = track_time.as_secs_f64() * 1e3 / totals.frames as f64;

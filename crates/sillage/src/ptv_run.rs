@@ -10,7 +10,10 @@ use sillage_io::{
     open_frames, read_tractrac_par,
 };
 
-use crate::config::PipelineConfig;
+use sillage_detect::blob::Calibration;
+use sillage_image::Polarity;
+
+use crate::config::{DetectorConfig, PipelineConfig};
 use crate::pipeline::{FrameReport, Pipeline, RunSummary};
 use crate::toml_config::{Settings, dotted_keys, load_unvalidated, set_key};
 use crate::tractrac::apply_par;
@@ -42,13 +45,45 @@ pub fn load_ptv_config(
 }
 
 /// The header written into track files: our version and every parameter of `config` under
-/// its dotted key (`detector.scale_px`, `tracker.motion_av`), the keys `--set` takes.
-pub fn track_header(config: &PipelineConfig) -> Result<TrackFileHeader> {
+/// its dotted key (`detector.scale_px`, `tracker.motion_av`), the keys `--set` takes; then,
+/// when the blob detector's scale or polarity was measured, the values in use and the
+/// measurement (`detector.measured.*`).
+pub fn track_header(
+    config: &PipelineConfig,
+    calibration: Option<&Calibration>,
+) -> Result<TrackFileHeader> {
+    let mut parameters = dotted_keys(config)?;
+    if let Some(calibration) = calibration
+        && let Some(measured) = &calibration.measured
+    {
+        parameters.extend([
+            (
+                "detector.measured.particle_sigma_px".to_string(),
+                format!("{:.3}", measured.sigma_px),
+            ),
+            (
+                "detector.measured.scale_px".to_string(),
+                format!("{:.3}", calibration.scale_px),
+            ),
+            (
+                "detector.measured.polarity".to_string(),
+                polarity_name(calibration.polarity).to_string(),
+            ),
+        ]);
+    }
     Ok(TrackFileHeader {
         program_version: format!("sillage {}", env!("CARGO_PKG_VERSION")),
-        parameters: dotted_keys(config)?,
+        parameters,
         ..TrackFileHeader::default()
     })
+}
+
+/// `bright` or `dark`, as the configuration spells them.
+pub fn polarity_name(polarity: Polarity) -> &'static str {
+    match polarity {
+        Polarity::Bright => "bright",
+        Polarity::Dark => "dark",
+    }
 }
 
 /// A pipeline ready to track a frame source: built, its background primed, the frames open.
@@ -72,6 +107,8 @@ impl PtvRun {
     /// Builds the pipeline of `config` for the frames of `input` (folder, glob, TIFF stack or
     /// video); with background subtraction, the model starts as the mean of the first frames
     /// (TracTrac's Eq. (2)), read from a first opening of the source.
+    /// An `"auto"` blob scale or polarity is measured on the first frame here, so that the
+    /// header records it.
     pub fn open(config: &PipelineConfig, input: &str) -> Result<Self> {
         let mut pipeline = Pipeline::from_config(config)?;
         let background_frames = if pipeline.background_init_frames() > 0 {
@@ -79,12 +116,22 @@ impl PtvRun {
         } else {
             None
         };
+        if let DetectorConfig::Blob(_) = config.detector
+            && let Some(first) = open_frames(input, &FrameOptions::default())?.next()
+        {
+            pipeline.calibrate(&first?)?;
+        }
         Ok(Self {
+            header: track_header(config, pipeline.calibration().as_ref())?,
             pipeline,
             frames: open_frames(input, &FrameOptions::default())?,
-            header: track_header(config)?,
             background_frames,
         })
+    }
+
+    /// The blob detector's scale and polarity in use and what was measured to choose them.
+    pub fn calibration(&self) -> Option<Calibration> {
+        self.pipeline.calibration()
     }
 
     /// How many frames the background model was initialised from (`None` without one).
@@ -135,7 +182,7 @@ mod tests {
 
     #[test]
     fn the_header_names_nested_keys_with_their_sections() {
-        let header = track_header(&PipelineConfig::default()).unwrap();
+        let header = track_header(&PipelineConfig::default(), None).unwrap();
         let keys: Vec<&str> = header.parameters.iter().map(|(k, _)| k.as_str()).collect();
         assert!(keys.contains(&"tracker.motion_av"), "{keys:?}");
         assert!(

@@ -4,8 +4,9 @@
 //! live display and its own post-processing).
 
 use sillage_core::{Error, Result};
+use sillage_detect::blob::{PolarityChoice, Scale};
 use sillage_detect::{BlobFilter, Threshold};
-use sillage_image::{MedianSize, Polarity, Roi, SubpixelFit};
+use sillage_image::{MedianSize, Roi, SubpixelFit};
 use sillage_io::TractracPar;
 
 use crate::config::{DetectorConfig, PipelineConfig, TrackerConfig};
@@ -119,7 +120,7 @@ pub fn apply_par(config: &mut PipelineConfig, par: &TractracPar) -> Result<()> {
         };
     }
     if let Some(v) = par.peak_conv_size {
-        blob.scale_px = v;
+        blob.scale_px = Scale::Px(v);
     }
     if let Some(v) = par.peak_neigh {
         blob.neighbourhood = count("peak_neigh", v)?;
@@ -152,9 +153,9 @@ pub fn apply_par(config: &mut PipelineConfig, par: &TractracPar) -> Result<()> {
     }
     if let Some(v) = par.peak_minima {
         blob.polarity = if flag("peak_minima", v)? {
-            Polarity::Dark
+            PolarityChoice::Dark
         } else {
-            Polarity::Bright
+            PolarityChoice::Bright
         };
     }
     if let Some(roi) = roi(par)? {

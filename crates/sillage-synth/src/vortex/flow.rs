@@ -7,7 +7,7 @@ use rand::RngExt;
 use rand_distr::StandardNormal;
 use sillage_core::{Error, FrameIndex, Point2, Result, RngStream, TrackId, Vec2, rng_stream};
 
-use super::VortexParams;
+use super::{FlowField, VortexParams};
 
 /// The deterministic map of Eqs. 13-16 (ξ = 0) for frame index `n` and time step `delta`:
 /// `c` is a position relative to the image centre, the result is its position one frame on.
@@ -35,6 +35,7 @@ pub fn vortex_map(c: Vec2, n: FrameIndex, delta: f64) -> Vec2 {
 #[derive(Debug, Clone)]
 pub struct VortexFlow {
     params: VortexParams,
+    field: FlowField,
     frame: FrameIndex,
     ids: Vec<TrackId>,
     positions: Vec<Point2>,
@@ -75,8 +76,17 @@ impl VortexFlow {
     }
 
     fn empty(params: VortexParams) -> Self {
+        let field = FlowField::new(
+            params.flow,
+            params.width,
+            params.height,
+            params.delta,
+            params.max_displacement_px,
+            params.seed,
+        );
         Self {
             params,
+            field,
             frame: 0,
             ids: Vec::new(),
             positions: Vec::new(),
@@ -105,14 +115,15 @@ impl VortexFlow {
         &self.params
     }
 
-    /// Moves every particle to the next frame: Eqs. 13-16 with ξ = `brownian` × the local
+    /// Moves every particle to the next frame: the flow's map (Eqs. 13-16 for the paper's
+    /// vortex) with ξ = `brownian` × the local
     /// deterministic displacement magnitude × N(0, 1) per axis, then the periodic boundary,
     /// then intermittency.
     pub fn advance(&mut self) {
         let centre = self.centre();
         for slot in 0..self.ids.len() {
             let c = self.positions[slot] - centre;
-            let deterministic = vortex_map(c, self.frame, self.params.delta);
+            let deterministic = self.field.map(c, self.frame);
             let rng = &mut self.rngs[slot];
             let xi = if self.params.brownian > 0.0 {
                 let scale = self.params.brownian * (deterministic - c).norm();

@@ -1,11 +1,13 @@
 //! The synthetic vortex flow of the TracTrac paper (§4.1, Eqs. 13-16): positions, truth,
 //! rendered frames, and the flow's displacement statistics.
 
+mod fields;
 mod flow;
 mod params;
 mod sequence;
 mod truth;
 
+pub use fields::{FlowField, FlowKind};
 pub use flow::{VortexFlow, vortex_map};
 pub use params::VortexParams;
 pub use sequence::{SyntheticFrame, VortexSequence};

@@ -1,8 +1,10 @@
 //! Parameters of the synthetic vortex flow (TracTrac paper §4.1.1) and their checks.
 
+use rand::RngExt;
 use serde::{Deserialize, Serialize};
-use sillage_core::{Error, Result};
+use sillage_core::{Error, Result, rng_stream};
 
+use super::FlowKind;
 use crate::noise::{Noise, NoiseKind};
 
 /// Parameters of the vortex sequence. Defaults are the paper's Fig. 4 defaults where it gives
@@ -19,12 +21,20 @@ pub struct VortexParams {
     pub n_particles: usize,
     /// Number of frames the sequence yields (default 100: one period of Eq. 14's first term).
     pub n_frames: usize,
-    /// Time step δ of Eqs. 14-16 (default 0.01, §4.1.1).
+    /// The flow the particles follow (default the paper's vortex, Eqs. 13-16).
+    pub flow: FlowKind,
+    /// Time step δ of Eqs. 14-16 (default 0.01, §4.1.1); only for the paper's vortex.
     pub delta: f64,
+    /// Largest displacement of the other flows, px per frame (default 5); the paper's vortex
+    /// takes its speed from `delta`.
+    pub max_displacement_px: f64,
     /// Standard deviation of each particle's Gaussian blob, px (default 2.0). TracTrac's DoG
     /// (Gaussians of 0.8δ_det and 1.2δ_det, §2.2) answers most to a blob of std
     /// √(0.8 · 1.2) δ_det ≈ 0.98 δ_det, so 2 px suits its δ_det = 2 px.
     pub blob_sigma_px: f64,
+    /// When set, each particle's blob std is drawn uniformly in `[blob_sigma_px, this]` once
+    /// for its identity (real particle images differ in size); default unset: all the same.
+    pub blob_sigma_max_px: Option<f64>,
     /// Blob peak amplitude A in grey levels, full scale 1 (default 0.5, which leaves room for
     /// the noise and for overlaps below full scale).
     pub peak: f64,
@@ -51,8 +61,11 @@ impl Default for VortexParams {
             height: 1024,
             n_particles: 1000,
             n_frames: 100,
+            flow: FlowKind::PaperVortex,
             delta: 0.01,
+            max_displacement_px: 5.0,
             blob_sigma_px: 2.0,
+            blob_sigma_max_px: None,
             peak: 0.5,
             snr: 4.0,
             noise: NoiseKind::Uniform,
@@ -62,6 +75,9 @@ impl Default for VortexParams {
         }
     }
 }
+
+/// Seed tag of the blob-size draws, apart from the particles' own streams.
+const SIGMA_STREAM_TAG: u64 = 0x5167_6d61;
 
 /// Largest image side accepted, px.
 const MAX_SIDE: usize = 32_768;
@@ -89,10 +105,18 @@ impl VortexParams {
         }
         check("delta", self.delta, 0.0..=1.0)?;
         check(
+            "max_displacement_px",
+            self.max_displacement_px,
+            0.0..=1000.0,
+        )?;
+        check(
             "blob_sigma_px",
             self.blob_sigma_px,
             f64::MIN_POSITIVE..=100.0,
         )?;
+        if let Some(max) = self.blob_sigma_max_px {
+            check("blob_sigma_max_px", max, self.blob_sigma_px..=100.0)?;
+        }
         check("peak", self.peak, f64::MIN_POSITIVE..=f64::MAX)?;
         if self.snr.is_nan() || self.snr <= 0.0 {
             return Err(Error::parameter(
@@ -103,6 +127,18 @@ impl VortexParams {
         }
         check("intermittency", self.intermittency, 0.0..=0.5)?;
         check("brownian", self.brownian, 0.0..=f64::MAX)
+    }
+
+    /// The blob std of the particle `track_id`: `blob_sigma_px`, or a draw in
+    /// `[blob_sigma_px, blob_sigma_max_px]` from the identity's own stream.
+    pub fn blob_sigma_of(&self, track_id: u64) -> f64 {
+        match self.blob_sigma_max_px {
+            Some(max) if max > self.blob_sigma_px => {
+                let mut rng = rng_stream(self.seed ^ SIGMA_STREAM_TAG, track_id);
+                rng.random_range(self.blob_sigma_px..=max)
+            }
+            _ => self.blob_sigma_px,
+        }
     }
 
     /// The pixel noise these parameters ask for: magnitude A / SNR.

@@ -51,12 +51,10 @@ impl Iterator for VortexSequence {
         let frame = self.truth.next()?;
         let params = self.truth.params();
         self.spots.clear();
-        self.spots.extend(
-            frame
-                .truth
-                .iter()
-                .map(|point| (point.pos_px, params.peak, params.blob_sigma_px)),
-        );
+        self.spots.extend(frame.truth.iter().map(|point| {
+            let sigma = params.blob_sigma_of(point.track_id);
+            (point.pos_px, params.peak, sigma)
+        }));
         let noise_seed = rng_stream(params.seed, NOISE_STREAM_TAG | frame.index).random();
         let mut image = GrayImage::new(params.width, params.height);
         render_into(&mut image, &self.spots, params.pixel_noise(), noise_seed);

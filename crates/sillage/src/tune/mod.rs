@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use sillage_core::{Detection, Error, GrayImage, Result};
-use sillage_detect::blob::BlobParams;
+use sillage_detect::blob::{BlobParams, Calibration, Scale};
 use sillage_image::{Peak, PeakFinder, Roi};
 use sillage_io::{Frame, FrameOptions, open_frames, write_text};
 
@@ -36,6 +36,8 @@ pub struct TuneSession {
     frames: Vec<Frame>,
     /// The configuration the page starts from.
     initial: PipelineConfig,
+    /// The scale and polarity measured on the first frame for an `"auto"` configuration.
+    measured: Option<Calibration>,
     /// Where "save" writes the configuration.
     save_path: PathBuf,
 }
@@ -50,8 +52,11 @@ struct StateReply<'a> {
     height: usize,
     /// File of each frame.
     files: Vec<String>,
-    /// The configuration to start from (JSON form of the TOML file).
+    /// The configuration to start from (JSON form of the TOML file), `"auto"` scale and
+    /// polarity replaced by the values measured on the first frame.
     config: &'a PipelineConfig,
+    /// What was measured on the first frame, when the configuration asked for it.
+    measured: Option<&'a Calibration>,
     /// Where "save" writes.
     save_path: String,
 }
@@ -133,15 +138,36 @@ pub fn serve_session(listener: &TcpListener, session: TuneSession) -> std::io::R
 
 impl TuneSession {
     /// A session on `frames` (at least one), starting from `initial`, saving to `save_path`.
-    pub fn new(frames: Vec<Frame>, initial: PipelineConfig, save_path: PathBuf) -> Result<Self> {
-        if frames.is_empty() {
+    /// An `"auto"` blob scale or polarity is measured on the first frame and the page starts
+    /// from the measured values (errors when the frame has no particles to measure).
+    pub fn new(
+        frames: Vec<Frame>,
+        mut initial: PipelineConfig,
+        save_path: PathBuf,
+    ) -> Result<Self> {
+        let Some(first) = frames.first() else {
             return Err(Error::input("no frame to tune on; check the input"));
+        };
+        let mut stage = DetectionStage::from_config(&initial)?;
+        stage.calibrate(first)?;
+        let measured = stage.calibration().filter(|c| c.measured.is_some());
+        if let (Some(calibration), DetectorConfig::Blob(blob)) = (&measured, &mut initial.detector)
+        {
+            blob.scale_px = Scale::Px((calibration.scale_px * 100.0).round() / 100.0);
+            blob.polarity = calibration.polarity.into();
         }
         Ok(Self {
             frames,
             initial,
+            measured,
             save_path,
         })
+    }
+
+    /// The scale and polarity measured on the first frame, when the configuration asked for
+    /// them.
+    pub fn measured(&self) -> Option<&Calibration> {
+        self.measured.as_ref()
     }
 
     /// Number of frames loaded.
@@ -192,6 +218,7 @@ impl TuneSession {
                 .map(|f| f.path.display().to_string())
                 .collect(),
             config: &self.initial,
+            measured: self.measured.as_ref(),
             save_path: self.save_path.display().to_string(),
         }
     }

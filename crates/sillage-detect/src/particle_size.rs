@@ -1,0 +1,332 @@
+//! The size and polarity of the particle images, measured from a frame: blobs found as maxima of
+//! the scale-normalised Laplacian of Gaussian over position and scale (Lindeberg's automatic
+//! scale selection), both signs at once.
+//!
+//! For a Gaussian particle image of std σ, `−s²∇²(G_s ∗ I)` at its centre is
+//! `2A·s²σ²/(s² + σ²)²`, largest at `s = σ` whatever the amplitude `A`: the scale of each
+//! blob's maximum is its σ. Noise maxima are kept out by a per-scale threshold (median + 6
+//! robust standard deviations of that scale's response); the polarity whose blobs stand out
+//! more (90th percentile of their significance) wins, and the measured σ is the median over its stronger half.
+
+use serde::Serialize;
+use sillage_core::{Error, GrayImage, Result};
+use sillage_image::{LogFilter, Polarity, median_mad};
+
+/// Smallest scale searched, px.
+const MIN_SCALE_PX: f64 = 0.5;
+/// Scales per octave (factor 2 in σ).
+const SCALES_PER_OCTAVE: usize = 4;
+/// Number of scales: 0.5 to 8 px. Maxima on the first and last scale are not kept (their
+/// true scale may lie outside), so particle images of σ ≈ 0.6 to 6.7 px are measured.
+const N_SCALES: usize = 4 * SCALES_PER_OCTAVE + 1;
+/// A blob must stand this many robust standard deviations above its scale's median response.
+const SIGNIFICANCE: f64 = 6.0;
+/// Fewer blobs than this are "no particles".
+const MIN_BLOBS: usize = 1;
+/// The noise of a scale's response is taken as at least this share of its largest magnitude,
+/// so that noise-free frames (robust deviation 0) still have a threshold.
+const NOISE_FLOOR: f32 = 1e-3;
+/// Largest side of the central crop measured (bounds the cost on very large frames).
+const MAX_SIDE_PX: usize = 1024;
+
+/// What [`measure_particle_images`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ParticleImages {
+    /// Median std σ of the particle images, px (a Gaussian of this σ matches them).
+    pub sigma_px: f64,
+    /// Whether the particles are brighter or darker than their background.
+    pub polarity: Polarity,
+    /// Blobs of that polarity the measurement used.
+    pub blobs: usize,
+    /// Blobs of the other polarity (for the record: a clear choice has far fewer).
+    pub blobs_other_polarity: usize,
+}
+
+/// One maximum over position and scale.
+#[derive(Debug, Clone, Copy)]
+struct Blob {
+    sigma_px: f64,
+    significance: f64,
+}
+
+/// Measures the particle images of `image` (its central `MAX_SIDE_PX`² at most). Errors with
+/// "no particles found" on a frame without at least `MIN_BLOBS` blobs of σ ≈ 0.6–6.7 px
+/// standing clear of the noise: empty, flat, pure noise or one huge blob.
+pub fn measure_particle_images(image: &GrayImage) -> Result<ParticleImages> {
+    let crop = central_crop(image);
+    let image = crop.as_ref().unwrap_or(image);
+    let (width, height) = image.dimensions();
+    if width < 3 || height < 3 {
+        return Err(no_particles(format!(
+            "the frame is {width}×{height} px, too small to measure particles in"
+        )));
+    }
+    let mut bright = Vec::new();
+    let mut dark = Vec::new();
+    let mut layers: [GrayImage; 3] = Default::default();
+    let mut noise = [(0.0f32, 0.0f32); 3];
+    let mut samples = Vec::new();
+    let pixel_noise = pixel_noise_sigma(image, &mut samples);
+    for k in 0..N_SCALES {
+        let slot = k % 3;
+        let scale = scale_of(k as f64);
+        LogFilter::new(scale)?.apply(image, Polarity::Bright, &mut layers[slot]);
+        let normalisation = (scale * scale) as f32;
+        layers[slot]
+            .as_mut_slice()
+            .iter_mut()
+            .for_each(|v| *v *= normalisation);
+        let floor = NOISE_FLOOR
+            * layers[slot]
+                .as_slice()
+                .iter()
+                .fold(0.0f32, |m, v| m.max(v.abs()));
+        let white = pixel_noise * white_noise_gain(scale)?;
+        noise[slot] = match median_mad(&layers[slot], &mut samples) {
+            Some(s) => (s.median as f32, (s.sigma as f32).min(white).max(floor)),
+            None => (0.0, 0.0),
+        };
+        if k >= 2 {
+            let (below, centre, above) = ((k - 2) % 3, (k - 1) % 3, slot);
+            collect_maxima(
+                &layers,
+                [below, centre, above],
+                noise[centre],
+                k - 1,
+                &mut bright,
+                &mut dark,
+            );
+        }
+    }
+    let (polarity, mut chosen, other) = if contrast(&mut bright) >= contrast(&mut dark) {
+        (Polarity::Bright, bright, dark.len())
+    } else {
+        (Polarity::Dark, dark, bright.len())
+    };
+    if chosen.len() < MIN_BLOBS {
+        return Err(no_particles(format!(
+            "{} bright and {other} dark blob(s) of σ 0.6–6.7 px stand {SIGNIFICANCE} robust \
+             standard deviations above the noise: the frame looks empty, flat, pure noise or \
+             one large object",
+            chosen.len()
+        )));
+    }
+    // The stronger half (`chosen` is sorted by decreasing significance): weak maxima are the
+    // likeliest to be noise or overlaps.
+    let half = chosen.len().div_ceil(2);
+    let strong = &mut chosen[..half];
+    strong.sort_by(|a, b| a.sigma_px.total_cmp(&b.sigma_px));
+    Ok(ParticleImages {
+        sigma_px: strong[strong.len() / 2].sigma_px,
+        polarity,
+        blobs: chosen.len(),
+        blobs_other_polarity: other,
+    })
+}
+
+/// Robust std of the pixel noise (Immerkær's estimator, with a median instead of a mean): the
+/// mask `[1 −2 1; −2 4 −2; 1 −2 1]` cancels smooth structure, so on white noise of std σₙ its
+/// output has std 6σₙ, and particles barely reach it. Infinity when the frame is too small.
+fn pixel_noise_sigma(image: &GrayImage, samples: &mut Vec<f32>) -> f32 {
+    let (width, height) = image.dimensions();
+    if width < 3 || height < 3 {
+        return f32::INFINITY;
+    }
+    let mut response = GrayImage::new(width - 2, height - 2);
+    for y in 1..height - 1 {
+        let (up, row, down) = (image.row(y - 1), image.row(y), image.row(y + 1));
+        let out = response.row_mut(y - 1);
+        for (i, value) in out.iter_mut().enumerate() {
+            let x = i + 1;
+            let ring = up[x - 1] + up[x + 1] + down[x - 1] + down[x + 1];
+            let cross = up[x] + down[x] + row[x - 1] + row[x + 1];
+            *value = ring - 2.0 * cross + 4.0 * row[x];
+        }
+    }
+    median_mad(&response, samples).map_or(f32::INFINITY, |s| s.sigma as f32 / 6.0)
+}
+
+/// The std of the normalised LoG response at `scale` to unit white noise, measured on a
+/// seeded noise image (the discrete filter, not a continuous approximation).
+fn white_noise_gain(scale: f64) -> Result<f32> {
+    const SIDE: usize = 128;
+    let mut noise = uniform_noise(SIDE, SIDE, 0x9e37_79b9_7f4a_7c15);
+    // Uniform in [-√3, √3): unit variance.
+    noise
+        .as_mut_slice()
+        .iter_mut()
+        .for_each(|v| *v = (*v - 0.5) * 2.0 * 3f32.sqrt());
+    let mut response = GrayImage::default();
+    LogFilter::new(scale)?.apply(&noise, Polarity::Bright, &mut response);
+    let n = response.as_slice().len() as f64;
+    let variance = response
+        .as_slice()
+        .iter()
+        .map(|&v| f64::from(v).powi(2))
+        .sum::<f64>()
+        / n;
+    Ok((variance.sqrt() * scale * scale) as f32)
+}
+
+/// A `width × height` image of uniform values in `[0, 1)` from a fixed linear congruential
+/// sequence started at `seed` (deterministic, no dependency).
+fn uniform_noise(width: usize, height: usize, seed: u64) -> GrayImage {
+    let mut state = seed;
+    let mut image = GrayImage::new(width, height);
+    for v in image.as_mut_slice() {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        *v = (state >> 40) as f32 / (1u64 << 24) as f32;
+    }
+    image
+}
+
+/// How clearly blobs of one polarity stand out: the significance of their 90th percentile
+/// (0 without blobs). A percentile, not a sum, so that many weak blobs of the other sign
+/// (the dark gaps between bright particles, the ghosts a moving particle leaves in a
+/// background estimate) do not outvote the particles themselves. Sorts `blobs` by
+/// decreasing significance.
+fn contrast(blobs: &mut [Blob]) -> f64 {
+    blobs.sort_by(|a, b| b.significance.total_cmp(&a.significance));
+    blobs.get(blobs.len() / 10).map_or(0.0, |b| b.significance)
+}
+
+/// The error of a frame without measurable particles.
+fn no_particles(why: String) -> Error {
+    Error::input(format!(
+        "no particles found to measure their size and polarity: {why}; check the frame, or \
+         set detector.scale_px and detector.polarity by hand"
+    ))
+}
+
+/// Scale number `k` (fractional between scales) in px.
+fn scale_of(k: f64) -> f64 {
+    MIN_SCALE_PX * 2f64.powf(k / SCALES_PER_OCTAVE as f64)
+}
+
+/// The central `MAX_SIDE_PX` × `MAX_SIDE_PX` of `image`, when it is larger.
+fn central_crop(image: &GrayImage) -> Option<GrayImage> {
+    let (width, height) = image.dimensions();
+    if width <= MAX_SIDE_PX && height <= MAX_SIDE_PX {
+        return None;
+    }
+    let (w, h) = (width.min(MAX_SIDE_PX), height.min(MAX_SIDE_PX));
+    let (x0, y0) = ((width - w) / 2, (height - h) / 2);
+    let mut data = Vec::with_capacity(w * h);
+    for y in y0..y0 + h {
+        data.extend_from_slice(&image.row(y)[x0..x0 + w]);
+    }
+    GrayImage::from_vec(w, h, data).ok()
+}
+
+/// Adds the maxima of scale `k` (layer `ids[1]`, its neighbours `ids[0]` below and `ids[2]`
+/// above) to `bright` (positive response) and `dark` (negative): extrema of their 3×3×3
+/// neighbourhood beyond the scale's noise threshold.
+fn collect_maxima(
+    layers: &[GrayImage; 3],
+    ids: [usize; 3],
+    (median, sigma): (f32, f32),
+    k: usize,
+    bright: &mut Vec<Blob>,
+    dark: &mut Vec<Blob>,
+) {
+    if sigma <= 0.0 {
+        return;
+    }
+    let centre = &layers[ids[1]];
+    let (width, height) = centre.dimensions();
+    let threshold = SIGNIFICANCE as f32 * sigma;
+    for y in 1..height - 1 {
+        let row = centre.row(y);
+        for (x, &here) in row.iter().enumerate().take(width - 1).skip(1) {
+            let v = here - median;
+            if v.abs() <= threshold {
+                continue;
+            }
+            let sign = v.signum();
+            let value = sign * here;
+            let is_extremum = ids.iter().all(|&id| {
+                let layer = &layers[id];
+                (y - 1..=y + 1).all(|yy| {
+                    let r = layer.row(yy);
+                    (x - 1..=x + 1).all(|xx| {
+                        let other = sign * r[xx];
+                        other < value || (other == value && (id, yy, xx) == (ids[1], y, x))
+                    })
+                })
+            });
+            if !is_extremum {
+                continue;
+            }
+            let at = |id: usize| f64::from(sign * layers[id].get(x, y));
+            let offset = sillage_image::parabola_offset(at(ids[0]), at(ids[1]), at(ids[2]));
+            let blob = Blob {
+                sigma_px: scale_of(k as f64 + offset),
+                significance: f64::from(v.abs() / sigma),
+            };
+            if sign > 0.0 {
+                bright.push(blob);
+            } else {
+                dark.push(blob);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spots(sigma: f64, amplitude: f32) -> GrayImage {
+        let (w, h) = (160, 160);
+        let mut image = GrayImage::new(w, h);
+        for gy in 1..8 {
+            for gx in 1..8 {
+                let (cx, cy) = (gx as f64 * 20.0 + 0.3, gy as f64 * 20.0 - 0.2);
+                for y in 0..h {
+                    for x in 0..w {
+                        let r2 = (x as f64 - cx).powi(2) + (y as f64 - cy).powi(2);
+                        let v = image.get(x, y)
+                            + amplitude * (-r2 / (2.0 * sigma * sigma)).exp() as f32;
+                        image.set(x, y, v);
+                    }
+                }
+            }
+        }
+        image
+    }
+
+    #[test]
+    fn measures_sigma_and_polarity_of_clean_spots() {
+        for sigma in [0.8, 1.5, 3.0] {
+            for (amplitude, polarity) in [(0.5, Polarity::Bright), (-0.5, Polarity::Dark)] {
+                let m = measure_particle_images(&spots(sigma, amplitude)).unwrap();
+                assert_eq!(m.polarity, polarity, "σ {sigma}");
+                assert!((m.sigma_px / sigma - 1.0).abs() < 0.15, "σ {sigma}: {m:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn frames_without_particles_say_so() {
+        let mut huge = GrayImage::new(256, 256);
+        for y in 0..256 {
+            for x in 0..256 {
+                let r2 = (x as f64 - 128.0).powi(2) + (y as f64 - 128.0).powi(2);
+                huge.set(x, y, (-r2 / (2.0 * 40.0 * 40.0)).exp() as f32);
+            }
+        }
+        let mut flat = GrayImage::new(64, 64);
+        flat.as_mut_slice().fill(0.7);
+        for (what, image) in [
+            ("empty", GrayImage::new(0, 0)),
+            ("flat", flat),
+            ("pure noise", uniform_noise(512, 512, 12345)),
+            ("one huge blob", huge),
+        ] {
+            let err = measure_particle_images(&image).unwrap_err().to_string();
+            assert!(err.contains("no particles found"), "{what}: {err}");
+        }
+    }
+}
