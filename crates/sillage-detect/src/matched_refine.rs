@@ -34,6 +34,7 @@ pub(crate) struct MatchedRefiner {
     peaks: Vec<Peak>,
     cell_start: Vec<u32>,
     cell_members: Vec<u32>,
+    isolated: Vec<bool>,
     grid: (usize, usize),
 }
 
@@ -48,6 +49,7 @@ impl MatchedRefiner {
             peaks: Vec::new(),
             cell_start: Vec::new(),
             cell_members: Vec::new(),
+            isolated: Vec::new(),
             grid: (1, 1),
         })
     }
@@ -66,8 +68,8 @@ impl MatchedRefiner {
         detections: &mut Vec<Detection>,
     ) {
         self.dog.apply(input, polarity, &mut self.matched);
-        let isolated = self.isolated(input.dimensions(), offset, detections);
-        for (detection, isolated) in detections.iter_mut().zip(&isolated) {
+        self.mark_isolated(input.dimensions(), offset, detections);
+        for (detection, &isolated) in detections.iter_mut().zip(&self.isolated) {
             if !isolated {
                 continue;
             }
@@ -98,14 +100,14 @@ impl MatchedRefiner {
         }
     }
 
-    /// Whether each detection has no other within the isolation radius (a grid of cells as
-    /// wide as the radius, counting-sorted).
-    fn isolated(
+    /// Sets `self.isolated`: whether each detection has no other within the isolation radius
+    /// (a grid of cells as wide as the radius, counting-sorted).
+    fn mark_isolated(
         &mut self,
         (width, height): (usize, usize),
         offset: (f64, f64),
         detections: &[Detection],
-    ) -> Vec<bool> {
+    ) {
         let r = self.isolation_px;
         let (cols, rows) = (
             (width as f64 / r).ceil() as usize + 1,
@@ -123,26 +125,27 @@ impl MatchedRefiner {
         }
         self.cell_members.clear();
         self.cell_members.resize(detections.len(), 0);
-        let mut fill = self.cell_start.clone();
+        // Each cell's start serves as its fill cursor, then is shifted back into place.
         for (i, d) in detections.iter().enumerate() {
             let (cx, cy) = self.cell_of(d.pos_px, offset);
-            let slot = &mut fill[cy * cols + cx];
+            let slot = &mut self.cell_start[cy * cols + cx];
             self.cell_members[*slot as usize] = i as u32;
             *slot += 1;
         }
+        self.cell_start.copy_within(0..cols * rows, 1);
+        self.cell_start[0] = 0;
         let r2 = r * r;
-        detections
-            .iter()
-            .enumerate()
-            .map(|(i, d)| {
-                self.neighbours(d.pos_px, offset).all(|j| {
-                    j == i || {
-                        let q = detections[j].pos_px;
-                        (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2) >= r2
-                    }
-                })
+        let mut isolated = std::mem::take(&mut self.isolated);
+        isolated.clear();
+        isolated.extend(detections.iter().enumerate().map(|(i, d)| {
+            self.neighbours(d.pos_px, offset).all(|j| {
+                j == i || {
+                    let q = detections[j].pos_px;
+                    (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2) >= r2
+                }
             })
-            .collect()
+        }));
+        self.isolated = isolated;
     }
 
     /// The grid cell of position `p` (with `offset`).
@@ -153,7 +156,7 @@ impl MatchedRefiner {
         (cx.min(cols - 1), cy.min(rows - 1))
     }
 
-    /// The members of the cells around `p`'s, as built by [`MatchedRefiner::isolated`].
+    /// The members of the cells around `p`'s, as built by [`MatchedRefiner::mark_isolated`].
     fn neighbours(&self, p: Point2, offset: (f64, f64)) -> impl Iterator<Item = usize> + '_ {
         let (cols, rows) = self.grid;
         let (cx, cy) = self.cell_of(p, offset);
