@@ -74,6 +74,15 @@ pub fn run(args: &PtvArgs) -> Result<()> {
     progress.finish();
     let tracked = outcome?;
     let summary = tracked.summary;
+    if let Some(displacement) = summary.measured_displacement_px {
+        let voting = summary.vote_search_px.map_or("off".to_string(), |r| {
+            format!("on, search radius {r:.1} px")
+        });
+        eprintln!(
+            "displacements measured on the first two frames: 95 % within {displacement:.2} px \
+             → displacement voting {voting}"
+        );
+    }
     if args.json.enabled {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {

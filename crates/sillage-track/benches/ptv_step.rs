@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
 use sillage_core::{Detection, DiscardSink, FrameObservations, Point2, Tracker, Vec2, rng_stream};
-use sillage_track::ptv::{PtvParams, PtvTracker};
+use sillage_track::ptv::{PtvParams, PtvTracker, VoteSearch};
 
 const WARM_FRAMES: usize = 8;
 
@@ -56,7 +56,7 @@ fn ptv_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("ptv_step");
     group.sample_size(20);
     let voting = PtvParams {
-        vote_search_px: Some(10.0),
+        vote_search_px: VoteSearch::Px(10.0),
         ..Default::default()
     };
     for (name, params) in [("default", PtvParams::default()), ("voting", voting)] {

@@ -4,7 +4,7 @@ use std::collections::HashMap;
 
 use rand::RngExt;
 use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker, Vec2, rng_stream};
-use sillage_track::ptv::{PassDirection, PtvParams, PtvTracker};
+use sillage_track::ptv::{PassDirection, PtvParams, PtvTracker, VoteSearch};
 
 /// Detections per frame and the true particle id of each detection.
 struct Scene {
@@ -204,14 +204,19 @@ fn motion_model_tracks_a_fast_rotation_far_better() {
     // 3000 particles in a disk of 250 px: spacing √(S/N) ≈ 8.1 px; displacement 0.03·r,
     // 5 px at the mean radius and 7.5 px at the edge: p⁻¹ ≈ 0.6–0.9.
     let scene = rotating(2, 3000, (0.03, 0.0), 30, 1.0, 0);
-    let no_model = PtvParams {
-        motion: false,
+    // TracTrac's algorithm: no displacement voting.
+    let tractrac = PtvParams {
+        vote_search_px: VoteSearch::OFF,
         ..Default::default()
     };
+    let no_model = PtvParams {
+        motion: false,
+        ..tractrac.clone()
+    };
     let (without, _) = scene.link_scores(&scene.track(no_model));
-    let (one_pass, _) = scene.link_scores(&scene.track(PtvParams::default()));
+    let (one_pass, _) = scene.link_scores(&scene.track(tractrac.clone()));
     // TracTrac's default `vid_loop = 2`: forward and backward training passes first.
-    let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
+    let mut tracker = PtvTracker::new(tractrac).unwrap();
     scene.feed(&mut tracker, PassDirection::Forward);
     scene.feed(&mut tracker, PassDirection::Backward);
     let (trained, precision) = scene.link_scores(&scene.feed(&mut tracker, PassDirection::Forward));
@@ -230,17 +235,28 @@ fn displacement_voting_tracks_a_rotation_faster_than_the_spacing_in_one_pass() {
     // frame: displacement 0.1·r, 12.5 px at the mean radius and 25 px at the edge
     // (p⁻¹ ≈ 0.9–1.8). TracTrac's predictor starts from zero motion and never recovers.
     let scene = rotating(4, 1000, (0.1, 0.0), 20, 1.0, 0);
-    let (tractrac, _) = scene.link_scores(&scene.track(PtvParams::default()));
+    let off = PtvParams {
+        vote_search_px: VoteSearch::OFF,
+        ..Default::default()
+    };
+    let (tractrac, _) = scene.link_scores(&scene.track(off));
     let voting = PtvParams {
-        vote_search_px: Some(40.0),
+        vote_search_px: VoteSearch::Px(40.0),
         ..Default::default()
     };
     let (recall, precision) = scene.link_scores(&scene.track(voting));
-    eprintln!("TracTrac recall {tractrac:.3}; voting recall {recall:.3}, precision {precision:.4}");
+    // The default measures the displacements on the first two frames and votes by itself.
+    let (auto_recall, auto_precision) = scene.link_scores(&scene.track(PtvParams::default()));
+    eprintln!(
+        "TracTrac recall {tractrac:.3}; voting recall {recall:.3}, precision {precision:.4}; \
+         automatic {auto_recall:.3}, {auto_precision:.4}"
+    );
     assert!(tractrac < 0.5, "{tractrac}");
     // Measured 0.87 (the first frames and the disk's rim, where cells hold few points).
     assert!(recall > 0.85, "{recall}");
     assert!(precision > 0.98, "{precision}");
+    assert!(auto_recall > 0.85, "{auto_recall}");
+    assert!(auto_precision > 0.98, "{auto_precision}");
 }
 
 #[test]
@@ -341,7 +357,7 @@ fn output_does_not_depend_on_the_number_of_threads() {
             scene.track(params)
         })
     };
-    for vote_search_px in [None, Some(20.0)] {
+    for vote_search_px in [VoteSearch::OFF, VoteSearch::Px(20.0), VoteSearch::AUTO] {
         let (one, three) = (run(1, vote_search_px), run(3, vote_search_px));
         assert!(!one.is_empty());
         assert_eq!(format!("{one:?}"), format!("{three:?}"));
@@ -352,7 +368,7 @@ fn output_does_not_depend_on_the_number_of_threads() {
 fn empty_and_single_point_frames_do_not_panic() {
     let sizes = [0usize, 1, 0, 1, 1, 2, 0, 0, 3, 1, 1, 1];
     let with_additions = PtvParams {
-        vote_search_px: Some(30.0),
+        vote_search_px: VoteSearch::Px(30.0),
         ambiguity_ratio: Some(0.5),
         ..Default::default()
     };

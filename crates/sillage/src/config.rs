@@ -70,7 +70,7 @@ const MAX_TRAINING_PASSES: usize = 20;
 
 /// The optional keys (absent by default, so missing from the TOML output): key, an example
 /// value, and what setting it does.
-pub const OPTIONAL_KEYS: [(&str, &str, &str); 7] = [
+pub const OPTIONAL_KEYS: [(&str, &str, &str); 6] = [
     (
         "mask",
         "\"mask.png\"",
@@ -86,11 +86,6 @@ pub const OPTIONAL_KEYS: [(&str, &str, &str); 7] = [
         "detector.roi",
         "{ x0 = 0, y0 = 0, x1 = 512, y1 = 512 }",
         "region of interest, px",
-    ),
-    (
-        "tracker.vote_search_px",
-        "100",
-        "displacement voting for fast flows: largest displacement, px",
     ),
     (
         "tracker.ambiguity_ratio",

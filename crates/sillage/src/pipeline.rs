@@ -101,6 +101,11 @@ pub struct RunSummary {
     /// The blob detector's scale and polarity and, when `"auto"`, what was measured on the
     /// first frame to choose them; `None` for other detectors.
     pub detector: Option<Calibration>,
+    /// PTV with `vote_search_px = "auto"`: the displacement measured on the first two frames
+    /// (95th percentile, px).
+    pub measured_displacement_px: Option<f64>,
+    /// PTV: displacement voting's search radius in use at the end of the run (`None`: off).
+    pub vote_search_px: Option<f64>,
 }
 
 /// A configured detector and tracker, fed one frame at a time.
@@ -319,6 +324,10 @@ impl Pipeline {
         totals.points = counting.points;
         totals.tracks = counting.track_ids_seen;
         totals.detector = self.stage.calibration();
+        if let AnyTracker::Ptv(tracker) = &self.tracker {
+            totals.measured_displacement_px = tracker.measured_displacement();
+            totals.vote_search_px = tracker.vote_radius();
+        }
         if totals.frames > 0 {
             totals.detect_ms_per_frame = detect_time.as_secs_f64() * 1e3 / totals.frames as f64;
             totals.track_ms_per_frame = track_time.as_secs_f64() * 1e3 / totals.frames as f64;

@@ -17,6 +17,7 @@ use sillage_detect::{Polarity, Threshold, measure_particle_images};
 use sillage_eval::ptv::{PtvAccuracy, PtvAccuracyParams, ptv_accuracy};
 use sillage_io::Frame;
 use sillage_synth::vortex::{FlowKind, VortexParams, VortexSequence};
+use sillage_track::ptv::VoteSearch;
 
 use crate::config::{DetectorConfig, PipelineConfig, TrackerConfig};
 use crate::pipeline::Pipeline;
@@ -174,7 +175,7 @@ impl GridSetting {
         }
         if let TrackerConfig::Ptv(ptv) = &mut config.tracker {
             ptv.filter_std = self.filter_std;
-            ptv.vote_search_px = self.vote_search_px;
+            ptv.vote_search_px = self.vote_search_px.map_or(VoteSearch::OFF, VoteSearch::Px);
         }
         config
     }

@@ -20,5 +20,8 @@ mod params;
 mod tracker;
 mod voting;
 
-pub use params::PtvParams;
+pub use params::{
+    AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_SPACINGS, PtvParams, VoteMode,
+    VoteSearch,
+};
 pub use tracker::{PassDirection, PtvTracker};

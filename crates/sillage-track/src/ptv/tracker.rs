@@ -9,8 +9,21 @@ use sillage_core::{
 
 use super::filter::{INITIAL_THRESHOLD, log10_error, updated_threshold};
 use super::motion::{MotionField, Samples};
-use super::params::PtvParams;
-use super::voting::voted_displacements;
+use super::params::{
+    AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_SPACINGS, PtvParams, VoteMode,
+    VoteSearch,
+};
+use super::voting::{Vote, mean_spacing, voted_displacements};
+
+/// The automatic vote's first search radius, in mean spacings, and its smallest value in px.
+const AUTO_VOTE_NEAR_SPACINGS: f64 = 0.9;
+const AUTO_VOTE_NEAR_MIN_PX: f64 = 4.0;
+/// The search is widened when the 95th-percentile displacement reaches this share of it.
+const AUTO_VOTE_WIDEN: f64 = 0.7;
+/// The widened search radius, in mean spacings, and its bounds in px.
+const AUTO_VOTE_FIRST_SPACINGS: f64 = 4.0;
+const AUTO_VOTE_FIRST_MIN_PX: f64 = 16.0;
+const AUTO_VOTE_FIRST_MAX_PX: f64 = 64.0;
 
 /// Voted corrections shorter than this share of the mean spacing between points are left
 /// out: too small to change a nearest neighbour, they would only replace the model's own
@@ -103,6 +116,12 @@ pub struct PtvTracker {
     pred: Vec<Point2>,
     displacements: Vec<Vec2>,
     voted: Vec<Vec2>,
+    /// Voting's search radius once decided (`None`: off); `decided` false while an
+    /// automatic decision waits for the first two frames.
+    vote_radius: Option<f64>,
+    vote_decided: bool,
+    /// The displacement (95th percentile, px) the automatic decision measured.
+    measured_displacement: Option<f64>,
     forward: Vec<Option<Neighbour>>,
     two_nearest: Vec<Vec<Neighbour>>,
     link12: Vec<Option<usize>>,
@@ -121,6 +140,7 @@ impl PtvTracker {
     /// A tracker with validated `params`, starting a forward pass.
     pub fn new(params: PtvParams) -> Result<Self> {
         params.validate()?;
+        let vote = params.vote_search_px;
         Ok(Self {
             field: MotionField::new(params.motion_av, params.filter_time),
             params,
@@ -146,6 +166,12 @@ impl PtvTracker {
             pred: Vec::new(),
             displacements: Vec::new(),
             voted: Vec::new(),
+            vote_radius: match vote {
+                VoteSearch::Px(radius) => Some(radius),
+                VoteSearch::Mode(_) => None,
+            },
+            vote_decided: vote != VoteSearch::Mode(VoteMode::Auto),
+            measured_displacement: None,
             forward: Vec::new(),
             two_nearest: Vec::new(),
             link12: Vec::new(),
@@ -162,6 +188,17 @@ impl PtvTracker {
     /// The parameters in use.
     pub fn params(&self) -> &PtvParams {
         &self.params
+    }
+
+    /// Voting's search radius in use (`None`: off, or an automatic decision not yet made).
+    pub fn vote_radius(&self) -> Option<f64> {
+        self.vote_radius
+    }
+
+    /// The displacement an automatic voting decision measured on the first two frames (95th
+    /// percentile, px).
+    pub fn measured_displacement(&self) -> Option<f64> {
+        self.measured_displacement
     }
 
     /// Starts a new pass over the sequence in `direction` (TracTrac's `vid_loop`): forgets
@@ -249,7 +286,9 @@ impl PtvTracker {
             self.log_err_pred.clear();
             self.log_err_pred.resize(self.c1.len(), 0.0);
         }
-        if let Some(search_px) = self.params.vote_search_px {
+        if !self.vote_decided && !model_applied {
+            self.decide_voting(dt);
+        } else if let Some(search_px) = self.vote_radius {
             self.correct_by_voting(model_applied, search_px, dt);
         }
         self.pred.clear();
@@ -259,6 +298,47 @@ impl PtvTracker {
                 .zip(&self.vel_pred)
                 .map(|(&p, &u)| p + u * dt),
         );
+    }
+
+    /// The automatic voting decision ([`VoteSearch::AUTO`]) on the first two frames: a vote
+    /// from zero motion over four spacings measures the displacements (95th percentile).
+    /// When they reach [`AUTO_VOTE_FIRST_LINK_SPACINGS`] of the spacing, the vote predicts this
+    /// first link (and seeds the motion model), as voting does; when they reach
+    /// [`AUTO_VOTE_SPACINGS`], voting stays on for the rest of the run.
+    fn decide_voting(&mut self, dt: f64) {
+        self.vote_decided = true;
+        let spacing = mean_spacing(&self.c1);
+        // A search within one spacing first: a regular pattern (a calibration grid) votes
+        // as much for its period as for the true displacement, and slow flows need no more.
+        // Only when the displacements found reach the edge of that search is it widened.
+        let near_radius = (AUTO_VOTE_NEAR_SPACINGS * spacing).max(AUTO_VOTE_NEAR_MIN_PX);
+        let mut vote = self.vote_from_rest(near_radius);
+        if vote.is_none() || percentile_norm(&self.voted, 0.95) > AUTO_VOTE_WIDEN * near_radius {
+            let far_radius = (AUTO_VOTE_FIRST_SPACINGS * spacing)
+                .clamp(AUTO_VOTE_FIRST_MIN_PX, AUTO_VOTE_FIRST_MAX_PX);
+            vote = self.vote_from_rest(far_radius);
+        }
+        let Some(vote) = vote else {
+            return;
+        };
+        let p95 = percentile_norm(&self.voted, 0.95);
+        self.measured_displacement = Some(p95);
+        if p95 >= AUTO_VOTE_FIRST_LINK_SPACINGS * spacing {
+            self.displacements.clear();
+            self.displacements.resize(self.c1.len(), Vec2::ZERO);
+            self.apply_votes(&vote, false, dt);
+        }
+        if p95 >= AUTO_VOTE_SPACINGS * spacing {
+            self.vote_radius = Some((AUTO_VOTE_MARGIN * p95).max(1.0));
+        }
+    }
+
+    /// The displacements voted from zero motion within `radius` px, into `self.voted`.
+    fn vote_from_rest(&mut self, radius: f64) -> Option<Vote> {
+        let mut voted = std::mem::take(&mut self.voted);
+        let vote = voted_displacements(&self.c1, &self.c2, None, radius, &mut voted);
+        self.voted = voted;
+        vote
     }
 
     /// Displacement voting (`vote_search_px`): replaces the predicted velocities by the
@@ -271,32 +351,41 @@ impl PtvTracker {
         self.displacements
             .extend(self.vel_pred.iter().map(|&u| u * dt));
         let mut voted = std::mem::take(&mut self.voted);
-        if let Some(vote) = voted_displacements(
+        let vote = voted_displacements(
             &self.c1,
             &self.c2,
             Some(&self.displacements),
             search_px,
             &mut voted,
-        ) {
-            let min_correction_px = VOTE_MIN_CORRECTION_SPACINGS * vote.spacing_px;
-            for ((u, &d), &prior) in self
-                .vel_pred
-                .iter_mut()
-                .zip(&voted)
-                .zip(&self.displacements)
-            {
-                if !model_applied || (d - prior).norm() > min_correction_px {
-                    *u = d / dt;
-                }
-            }
-            if !model_applied {
-                self.stored.clear();
-                for (&p, &u) in self.c1.iter().zip(&self.vel_pred) {
-                    self.stored.push(p, u, vote.resolution_px.log10());
-                }
+        );
+        self.voted = voted;
+        if let Some(vote) = vote {
+            self.apply_votes(&vote, model_applied, dt);
+        }
+    }
+
+    /// Takes the voted displacements `self.voted` (priors in `self.displacements`) as the
+    /// predicted velocities, where they differ from the prior by more than
+    /// [`VOTE_MIN_CORRECTION_SPACINGS`] of the spacing (everywhere without a model, whose
+    /// samples they then become).
+    fn apply_votes(&mut self, vote: &Vote, model_applied: bool, dt: f64) {
+        let min_correction_px = VOTE_MIN_CORRECTION_SPACINGS * vote.spacing_px;
+        for ((u, &d), &prior) in self
+            .vel_pred
+            .iter_mut()
+            .zip(&self.voted)
+            .zip(&self.displacements)
+        {
+            if !model_applied || (d - prior).norm() > min_correction_px {
+                *u = d / dt;
             }
         }
-        self.voted = voted;
+        if !model_applied {
+            self.stored.clear();
+            for (&p, &u) in self.c1.iter().zip(&self.vel_pred) {
+                self.stored.push(p, u, vote.resolution_px.log10());
+            }
+        }
     }
 
     /// Mutual nearest neighbours between the predictions and frame t (Eq. 9 then §3.1.2),
@@ -508,6 +597,16 @@ fn retain_links(
             link21[k] = None;
         }
     }
+}
+
+/// The `q` quantile of the norms of `vectors` (0 when empty).
+fn percentile_norm(vectors: &[Vec2], q: f64) -> f64 {
+    if vectors.is_empty() {
+        return 0.0;
+    }
+    let mut norms: Vec<f64> = vectors.iter().map(|d| d.norm()).collect();
+    let at = ((norms.len() - 1) as f64 * q).round() as usize;
+    *norms.select_nth_unstable_by(at, f64::total_cmp).1
 }
 
 impl Tracker for PtvTracker {

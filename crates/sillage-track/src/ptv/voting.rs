@@ -105,6 +105,14 @@ pub(crate) fn voted_displacements(
     }
 }
 
+/// Mean spacing between `points`, `√(bounding-box area / n)`, px (0 without points).
+pub(crate) fn mean_spacing(points: &[Point2]) -> f64 {
+    if points.is_empty() {
+        return 0.0;
+    }
+    (Extent::covering(points.iter()).area() / points.len() as f64).sqrt()
+}
+
 /// Bounding box of the points of both frames.
 struct Extent {
     min: Point2,
