@@ -1,4 +1,6 @@
-//! Blob detection on a 2048² frame with ~25,000 Gaussian spots (σ = 1.2 px) and noise, seeded.
+//! Blob detection on a 2048² frame with ~25,000 Gaussian spots (σ = 1.2 px) and noise, seeded:
+//! the defaults (scale and polarity measured on the first call, then the matched-scale second
+//! look), a given scale (no second look), and the measurement itself (once per run).
 //! Run with `cargo bench -p sillage-detect --bench blob`.
 
 #[path = "../tests/common/mod.rs"]
@@ -9,7 +11,9 @@ use std::hint::black_box;
 use common::{Rng, Spot, render};
 use criterion::{Criterion, criterion_group, criterion_main};
 use sillage_core::Detector;
-use sillage_detect::{BlobDetector, BlobFilter, BlobParams};
+use sillage_detect::{
+    BlobDetector, BlobFilter, BlobParams, PolarityChoice, Scale, measure_particle_images,
+};
 
 fn bench_blob(c: &mut Criterion) {
     let side = 2048;
@@ -30,10 +34,25 @@ fn bench_blob(c: &mut Criterion) {
         })
         .unwrap();
         let mut out = Vec::new();
+        // The first call measures the particle images (benched on its own below).
+        detector.detect(&frame, &mut out).unwrap();
         group.bench_function(format!("{filter:?}"), |b| {
             b.iter(|| detector.detect(black_box(&frame), &mut out).unwrap())
         });
     }
+    let mut given = BlobDetector::new(BlobParams {
+        scale_px: Scale::Px(1.2),
+        polarity: PolarityChoice::Bright,
+        ..BlobParams::default()
+    })
+    .unwrap();
+    let mut out = Vec::new();
+    group.bench_function("Dog_given_scale", |b| {
+        b.iter(|| given.detect(black_box(&frame), &mut out).unwrap())
+    });
+    group.bench_function("measure_particle_images", |b| {
+        b.iter(|| measure_particle_images(black_box(&frame)).unwrap())
+    });
     group.finish();
 }
 

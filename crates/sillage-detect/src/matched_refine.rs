@@ -11,6 +11,7 @@
 //! particles keep the resolving scale's position, since the matched filter pulls neighbours
 //! together.
 
+use rayon::prelude::*;
 use sillage_core::{Detection, GrayImage, Point2, Result};
 use sillage_image::{DogFilter, Peak, PeakFinder, Polarity, SubpixelFit, refine_peak};
 
@@ -21,6 +22,8 @@ pub const ISOLATION_SIGMAS: f64 = 4.0;
 /// (noise detections within 4σ hide faint spots), 2σ 100 %; the same on the tune half of
 /// the accuracy family.
 pub const MERGE_SIGMAS: f64 = 2.0;
+/// Fewest detections or peaks a rayon task handles.
+const PAR_MIN_LEN: usize = 512;
 /// Steps of the climb from a detection to the matched image's local maximum.
 const MAX_CLIMB_STEPS: usize = 3;
 
@@ -35,6 +38,8 @@ pub(crate) struct MatchedRefiner {
     cell_start: Vec<u32>,
     cell_members: Vec<u32>,
     isolated: Vec<bool>,
+    /// The completion's candidates, in peak order (reused).
+    added: Vec<Option<Detection>>,
     grid: (usize, usize),
 }
 
@@ -50,6 +55,7 @@ impl MatchedRefiner {
             cell_start: Vec::new(),
             cell_members: Vec::new(),
             isolated: Vec::new(),
+            added: Vec::new(),
             grid: (1, 1),
         })
     }
@@ -69,35 +75,46 @@ impl MatchedRefiner {
     ) {
         self.dog.apply(input, polarity, &mut self.matched);
         self.mark_isolated(input.dimensions(), offset, detections);
-        for (detection, &isolated) in detections.iter_mut().zip(&self.isolated) {
-            if !isolated {
-                continue;
-            }
-            let local = Point2::new(detection.pos_px.x - offset.0, detection.pos_px.y - offset.1);
-            if let Some(refined) = self.fit_near(local, fit)
-                && refined.distance(local) < self.isolation_px / ISOLATION_SIGMAS
-            {
-                detection.pos_px = Point2::new(refined.x + offset.0, refined.y + offset.1);
-            }
-        }
+        let max_shift = self.isolation_px / ISOLATION_SIGMAS;
+        let this = &*self;
+        detections
+            .par_iter_mut()
+            .zip(this.isolated.par_iter())
+            .with_min_len(PAR_MIN_LEN)
+            .for_each(|(detection, &isolated)| {
+                if !isolated {
+                    return;
+                }
+                let local =
+                    Point2::new(detection.pos_px.x - offset.0, detection.pos_px.y - offset.1);
+                if let Some(refined) = this.fit_near(local, fit)
+                    && refined.distance(local) < max_shift
+                {
+                    detection.pos_px = Point2::new(refined.x + offset.0, refined.y + offset.1);
+                }
+            });
         let Some(threshold) = threshold(&self.matched) else {
             return;
         };
         self.finder
             .find(&self.matched, 1, threshold, &mut self.peaks);
         let merge2 = (MERGE_SIGMAS / ISOLATION_SIGMAS * self.isolation_px).powi(2);
-        let found = detections.len();
-        for peak in &self.peaks {
-            let Some(local) = refine_peak(&self.matched, peak.x, peak.y, fit) else {
-                continue;
-            };
-            let p = Point2::new(local.x + offset.0, local.y + offset.1);
-            // The grid holds the first `found` detections.
-            if self.nearest_within(p, offset, &detections[..found], merge2) {
-                continue;
-            }
-            detections.push(Detection::new(p, self.matched.get(peak.x, peak.y)));
-        }
+        // The grid holds the detections as they were before any is added.
+        let mut added = std::mem::take(&mut self.added);
+        let this = &*self;
+        let found: &[Detection] = detections;
+        this.peaks
+            .par_iter()
+            .with_min_len(PAR_MIN_LEN)
+            .map(|peak| {
+                let local = refine_peak(&this.matched, peak.x, peak.y, fit)?;
+                let p = Point2::new(local.x + offset.0, local.y + offset.1);
+                (!this.nearest_within(p, offset, found, merge2))
+                    .then(|| Detection::new(p, this.matched.get(peak.x, peak.y)))
+            })
+            .collect_into_vec(&mut added);
+        detections.extend(added.iter().flatten());
+        self.added = added;
     }
 
     /// Sets `self.isolated`: whether each detection has no other within the isolation radius
