@@ -20,7 +20,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sillage::config::OPTIONAL_KEYS;
 use sillage::core::{FrameIndex, Point2, TrackId, TrackPoint, Vec2};
+use sillage::detect::blob::Calibration;
 use sillage::io::{FrameOptions, open_frames};
+use sillage::ptv_run::polarity_name;
 use sillage::toml_config::dotted_keys;
 use sillage::{Pipeline, PipelineConfig};
 
@@ -64,7 +66,7 @@ fn locate<'py>(
     let config = config_of(&overrides)?;
     let arrays = FrameArrays::borrow(frames)?;
     let views = arrays.views()?;
-    let (frame, x, y, signal) = py.detach(|| {
+    let (frame, x, y, signal, calibration) = py.detach(|| {
         let between = Between::new(progress);
         let run = || {
             let mut pipeline = Pipeline::from_config(&config)?;
@@ -79,11 +81,12 @@ fn locate<'py>(
                 }
                 between.advance();
             }
-            Ok((frame, x, y, signal))
+            Ok((frame, x, y, signal, pipeline.calibration()))
         };
         between.result(run())
     })?;
     let columns = PyDict::new(py);
+    set_measured(&columns, calibration.as_ref(), None, None)?;
     columns.set_item("frame", frame.into_pyarray(py))?;
     columns.set_item("x", x.into_pyarray(py))?;
     columns.set_item("y", y.into_pyarray(py))?;
@@ -112,10 +115,10 @@ fn ptv<'py>(
                 }
                 let frames = open_frames(&path, &FrameOptions::default())?;
                 let mut points: Vec<TrackPoint> = Vec::new();
-                pipeline.run(between.frames(frames), &mut points, &mut |_| {
+                let summary = pipeline.run(between.frames(frames), &mut points, &mut |_| {
                     between.advance()
                 })?;
-                Ok(points)
+                Ok((points, summary))
             };
             between.result(run())
         })?
@@ -130,15 +133,48 @@ fn ptv<'py>(
                     pipeline.prime_background(frames_of(&views))?;
                 }
                 let mut points: Vec<TrackPoint> = Vec::new();
-                pipeline.run(between.frames(frames_of(&views)), &mut points, &mut |_| {
-                    between.advance()
-                })?;
-                Ok(points)
+                let summary =
+                    pipeline.run(between.frames(frames_of(&views)), &mut points, &mut |_| {
+                        between.advance()
+                    })?;
+                Ok((points, summary))
             };
             between.result(run())
         })?
     };
-    track_columns(py, &points)
+    let (points, summary) = points;
+    let columns = track_columns(py, &points)?;
+    set_measured(
+        &columns,
+        summary.detector.as_ref(),
+        summary.measured_displacement_px,
+        summary.vote_search_px,
+    )?;
+    Ok(columns)
+}
+
+/// Adds to `columns`, under `"measured"`, what the run measured from the frames (the Python
+/// side moves it to the DataFrame's `attrs`): the particle images' σ, the blob scale and
+/// polarity in use, and for PTV the first frames' displacement and the voting radius.
+fn set_measured(
+    columns: &Bound<'_, PyDict>,
+    calibration: Option<&Calibration>,
+    displacement_px: Option<f64>,
+    vote_search_px: Option<f64>,
+) -> PyResult<()> {
+    let measured = PyDict::new(columns.py());
+    if let Some(calibration) = calibration
+        && let Some(images) = &calibration.measured
+    {
+        measured.set_item("particle_sigma_px", images.sigma_px)?;
+        measured.set_item("scale_px", calibration.scale_px)?;
+        measured.set_item("polarity", polarity_name(calibration.polarity))?;
+    }
+    if let Some(displacement) = displacement_px {
+        measured.set_item("displacement_px", displacement)?;
+        measured.set_item("vote_search_px", vote_search_px)?;
+    }
+    columns.set_item("measured", measured)
 }
 
 /// One point's identity and motion: frame, track id, position and velocity, px and px/frame.

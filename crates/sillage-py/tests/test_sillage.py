@@ -73,6 +73,20 @@ def test_dtypes_and_layouts_give_the_same_detections(vortex):
     assert abs(len(u8) - len(reference)) < 0.1 * len(reference)
 
 
+def test_measured_particle_images_and_displacements_are_in_attrs(vortex):
+    frames, _ = vortex
+    features = sillage.batch(frames)
+    assert features.attrs["polarity"] == "bright"
+    # The vortex fixture draws particle images of σ = 2 px.
+    assert 1.7 < features.attrs["particle_sigma_px"] < 2.5
+    assert 0.5 < features.attrs["scale_px"] <= features.attrs["particle_sigma_px"]
+    tracks = sillage.ptv(frames)
+    assert tracks.attrs["particle_sigma_px"] == features.attrs["particle_sigma_px"]
+    assert tracks.attrs["displacement_px"] > 0
+    # A given size is used as given: nothing measured.
+    assert "particle_sigma_px" not in sillage.batch(frames, scale_px=2.0, polarity="bright").attrs
+
+
 def test_ptv_passes_through_trackpy(vortex):
     frames, truth = vortex
     tracks = sillage.ptv(frames, scale_px=2.0, motion_av=5)

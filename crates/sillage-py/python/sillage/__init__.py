@@ -95,6 +95,16 @@ def locate(frame: np.ndarray, *, params: Mapping[str, Any] | None = None,
     return batch(array, params=params, **detector)
 
 
+def _frame_with_measured(columns: dict, order: list[str]) -> pd.DataFrame:
+    """The DataFrame of ``columns`` in ``order``; what the run measured from the frames
+    (``particle_sigma_px``, ``scale_px``, ``polarity``, and for PTV ``displacement_px`` and
+    ``vote_search_px``) goes to its ``attrs``."""
+    measured = columns.pop("measured", {})
+    frame = pd.DataFrame(columns)[order]
+    frame.attrs.update(measured)
+    return frame
+
+
 def batch(frames: np.ndarray | Iterable[np.ndarray], *,
           params: Mapping[str, Any] | None = None, progress: bool = False,
           **detector: Any) -> pd.DataFrame:
@@ -106,11 +116,14 @@ def batch(frames: np.ndarray | Iterable[np.ndarray], *,
 
     >>> features = sillage.batch(frames, scale_px=2.0)
     >>> features.groupby("frame").size()
+
+    By default the particle size and polarity are measured on the first frame; the values
+    used are in ``features.attrs`` (``particle_sigma_px``, ``scale_px``, ``polarity``).
     """
     source = _frames_argument(frames)
     with _progress(progress, _frame_count(source), "locate") as update:
         columns = _sillage.locate(source, _overrides(detector, params, "detector"), update)
-    return pd.DataFrame(columns)[_DETECTION_COLUMNS]
+    return _frame_with_measured(columns, _DETECTION_COLUMNS)
 
 
 def ptv(frames: np.ndarray | Iterable[np.ndarray] | str, *,
@@ -137,7 +150,7 @@ def ptv(frames: np.ndarray | Iterable[np.ndarray] | str, *,
     total = None if isinstance(source, str) else _frame_count(source)
     with _progress(progress, total, "ptv") as update:
         columns = _sillage.ptv(source, _overrides(keywords, params, None), update)
-    return pd.DataFrame(columns)[_TRACK_COLUMNS]
+    return _frame_with_measured(columns, _TRACK_COLUMNS)
 
 
 def ptv_iter(frames: Iterable[np.ndarray] | str, *,
