@@ -411,17 +411,13 @@ const MIN_AUTO_SCALE_PX: f64 = 0.5;
 impl std::fmt::Display for Calibration {
     /// One line for run summaries: the measurement, then the values in use.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let polarity = |p: Polarity| match p {
-            Polarity::Bright => "bright",
-            Polarity::Dark => "dark",
-        };
         if let Some(m) = &self.measured {
             write!(
                 f,
                 "particle images measured on the first frame: σ {:.2} px, {} ({} blobs; {} of \
                  the other polarity) → ",
                 m.sigma_px,
-                polarity(m.polarity),
+                m.polarity.name(),
                 m.blobs,
                 m.blobs_other_polarity
             )?;
@@ -430,7 +426,7 @@ impl std::fmt::Display for Calibration {
             f,
             "detector.scale_px = {:.2}, detector.polarity = {}",
             self.scale_px,
-            polarity(self.polarity)
+            self.polarity.name()
         )
     }
 }

@@ -21,6 +21,14 @@ pub enum Polarity {
 }
 
 impl Polarity {
+    /// `bright` or `dark`, as configurations spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Polarity::Bright => "bright",
+            Polarity::Dark => "dark",
+        }
+    }
+
     /// `+1` for bright, `-1` for dark.
     pub fn sign(self) -> f32 {
         match self {

@@ -22,7 +22,6 @@ use sillage::config::OPTIONAL_KEYS;
 use sillage::core::{FrameIndex, Point2, TrackId, TrackPoint, Vec2};
 use sillage::detect::blob::Calibration;
 use sillage::io::{FrameOptions, open_frames};
-use sillage::ptv_run::polarity_name;
 use sillage::toml_config::dotted_keys;
 use sillage::{Pipeline, PipelineConfig};
 
@@ -168,7 +167,7 @@ fn set_measured(
     {
         measured.set_item("particle_sigma_px", images.sigma_px)?;
         measured.set_item("scale_px", calibration.scale_px)?;
-        measured.set_item("polarity", polarity_name(calibration.polarity))?;
+        measured.set_item("polarity", calibration.polarity.name())?;
     }
     if let Some(displacement) = displacement_px {
         measured.set_item("displacement_px", displacement)?;

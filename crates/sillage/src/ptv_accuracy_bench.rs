@@ -307,3 +307,62 @@ pub fn sweep(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_family_alternates_halves_and_crosses_every_level_once_per_flow() {
+        let cases = family();
+        assert_eq!(cases.len(), 24);
+        let tune = cases.iter().filter(|c| c.half == Half::Tune).count();
+        assert_eq!(tune, 12);
+        for flow in FlowKind::ALL {
+            let of_flow: Vec<_> = cases.iter().filter(|c| c.flow == flow).collect();
+            assert_eq!(of_flow.len(), 4, "{flow:?}");
+            for (levels, value) in [
+                (
+                    &SIGMA_LEVELS_PX,
+                    (|c: &FamilyCase| c.sigma_px) as fn(&FamilyCase) -> f64,
+                ),
+                (&DENSITY_LEVELS_PPP, |c: &FamilyCase| c.density_ppp),
+                (&DISPLACEMENT_LEVELS_PX, |c: &FamilyCase| {
+                    c.max_displacement_px
+                }),
+            ] {
+                for level in levels {
+                    assert_eq!(
+                        of_flow.iter().filter(|c| value(c) == *level).count(),
+                        1,
+                        "{flow:?}: level {level}"
+                    );
+                }
+            }
+            // Both halves see every flow.
+            assert!(of_flow.iter().any(|c| c.half == Half::Tune));
+            assert!(of_flow.iter().any(|c| c.half == Half::Report));
+        }
+    }
+
+    #[test]
+    fn a_small_case_is_scored_for_defaults_and_old_defaults() {
+        let case = FamilyCase {
+            name: "small".into(),
+            half: Half::Report,
+            flow: FlowKind::CellularArray,
+            sigma_px: 1.2,
+            density_ppp: 0.005,
+            max_displacement_px: 2.0,
+            snr: 12.0,
+            intermittency: 0.0,
+        };
+        let row = run_case(&case, 128, 6, false).unwrap();
+        assert_eq!(row.particles, 82);
+        assert!(row.tuned.is_none());
+        let sigma = row.measured_sigma_px.unwrap();
+        assert!((1.2..1.8).contains(&sigma), "{sigma}");
+        assert!(row.defaults.true_pct > 50.0, "{:?}", row.defaults);
+        assert!(row.old_defaults.true_pct > 0.0, "{:?}", row.old_defaults);
+    }
+}

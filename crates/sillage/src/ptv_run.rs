@@ -11,7 +11,6 @@ use sillage_io::{
 };
 
 use sillage_detect::blob::Calibration;
-use sillage_image::Polarity;
 
 use crate::config::{DetectorConfig, PipelineConfig};
 use crate::pipeline::{FrameReport, Pipeline, RunSummary};
@@ -67,7 +66,7 @@ pub fn track_header(
             ),
             (
                 "detector.measured.polarity".to_string(),
-                polarity_name(calibration.polarity).to_string(),
+                calibration.polarity.name().to_string(),
             ),
         ]);
     }
@@ -76,14 +75,6 @@ pub fn track_header(
         parameters,
         ..TrackFileHeader::default()
     })
-}
-
-/// `bright` or `dark`, as the configuration spells them.
-pub fn polarity_name(polarity: Polarity) -> &'static str {
-    match polarity {
-        Polarity::Bright => "bright",
-        Polarity::Dark => "dark",
-    }
 }
 
 /// A pipeline ready to track a frame source: built, its background primed, the frames open.
