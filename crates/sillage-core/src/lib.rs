@@ -29,6 +29,7 @@ mod image;
 mod observation;
 mod rng;
 mod roles;
+mod settings;
 
 pub use bbox::BoundingBox;
 pub use calibration::Calibration;
@@ -42,3 +43,4 @@ pub use observation::{
 };
 pub use rng::{RngStream, rng_stream};
 pub use roles::{Detector, DiscardSink, FrameObservations, TrackSink, Tracker};
+pub use settings::NumberOrWord;

@@ -2,7 +2,7 @@
 //! at scale δ, threshold, local maxima, sub-pixel fit (Eqs. (3)–(4)).
 
 use serde::{Deserialize, Serialize};
-use sillage_core::{Detection, Detector, Error, GrayImage, Point2, Result};
+use sillage_core::{Detection, Detector, Error, GrayImage, NumberOrWord, Point2, Result};
 use sillage_image::{
     DogFilter, LogFilter, MAX_SCALE_PX, PeakFinder, Polarity, Roi, SubpixelFit, mean_std,
     median_mad, refine_peak,
@@ -11,17 +11,44 @@ use sillage_image::{
 use crate::matched_refine::MatchedRefiner;
 use crate::particle_size::{ParticleImages, measure_particle_images};
 
-/// The blob scale δ: measured from the first frame, or given in px.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(untagged)]
+/// The blob scale δ: measured from the first frame, or given in px. In TOML, a number or
+/// `"auto"`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Scale {
     /// δ from the particle images' σ measured on the first frame ([`measure_particle_images`],
     /// [`auto_scale_px`]); `"auto"` in TOML, the default.
     #[default]
-    #[serde(with = "auto_keyword")]
     Auto,
     /// δ in px, in `(0, 50]`.
     Px(f64),
+}
+
+impl Serialize for Scale {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            Scale::Auto => serializer.serialize_str("auto"),
+            Scale::Px(px) => serializer.serialize_f64(*px),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Scale {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        let expected = "a number of px or \"auto\"";
+        match NumberOrWord::deserialize(deserializer) {
+            Ok(NumberOrWord::Number(px)) => Ok(Scale::Px(px)),
+            Ok(NumberOrWord::Word(word)) if word == "auto" => Ok(Scale::Auto),
+            Ok(NumberOrWord::Word(word)) => Err(serde::de::Error::custom(format!(
+                "expected {expected}, found \"{word}\""
+            ))),
+            Err(_) => Err(serde::de::Error::custom(format!("expected {expected}"))),
+        }
+    }
 }
 
 /// The particles' polarity: measured from the first frame, or given.
@@ -54,24 +81,6 @@ impl From<Polarity> for PolarityChoice {
         match polarity {
             Polarity::Bright => PolarityChoice::Bright,
             Polarity::Dark => PolarityChoice::Dark,
-        }
-    }
-}
-
-/// `Scale::Auto` as the string `"auto"`.
-mod auto_keyword {
-    use serde::{Deserialize, Deserializer, Serializer, de::Error};
-
-    pub fn serialize<S: Serializer>(serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.serialize_str("auto")
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<(), D::Error> {
-        match String::deserialize(deserializer)?.as_str() {
-            "auto" => Ok(()),
-            other => Err(D::Error::custom(format!(
-                "expected \"auto\" or a number of px, found \"{other}\""
-            ))),
         }
     }
 }

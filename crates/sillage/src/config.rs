@@ -192,6 +192,35 @@ mod tests {
     }
 
     #[test]
+    fn measured_settings_take_a_number_or_their_keywords() {
+        let mut config = PipelineConfig::default();
+        let text = config.to_toml_string().unwrap();
+        assert!(text.contains("scale_px = \"auto\""), "{text}");
+        assert!(text.contains("vote_search_px = \"auto\""), "{text}");
+        config.set("tracker.vote_search_px=off").unwrap();
+        config.set("detector.polarity=dark").unwrap();
+        let back = PipelineConfig::from_toml_str(&config.to_toml_string().unwrap()).unwrap();
+        assert_eq!(back, config);
+        config.set("tracker.vote_search_px=12.5").unwrap();
+        config.set("detector.scale_px=auto").unwrap();
+        let back = PipelineConfig::from_toml_str(&config.to_toml_string().unwrap()).unwrap();
+        assert_eq!(back, config);
+        for (assignment, expected) in [
+            (
+                "detector.scale_px=big",
+                "a number of px or \"auto\", found \"big\"",
+            ),
+            (
+                "tracker.vote_search_px=maybe",
+                "\"off\" or \"auto\", found \"maybe\"",
+            ),
+        ] {
+            let err = config.set(assignment).unwrap_err().to_string();
+            assert!(err.contains(expected), "{err}");
+        }
+    }
+
+    #[test]
     fn bad_overrides_name_the_key() {
         let mut config = PipelineConfig::default();
         let err = config.set("detector.scale_pix=3").unwrap_err().to_string();

@@ -1,7 +1,7 @@
 //! Parameters of the PTV tracker, with TracTrac's defaults.
 
 use serde::{Deserialize, Serialize};
-use sillage_core::{Error, Result};
+use sillage_core::{Error, NumberOrWord, Result};
 
 /// Parameters of [`crate::ptv::PtvTracker`]. Keys and defaults are those of TracTrac's
 /// parameter file as its command line fills them in (`set_default_parameter`), so a
@@ -64,9 +64,9 @@ impl Default for PtvParams {
     }
 }
 
-/// Displacement voting: off, on over a given radius, or decided from the first two frames.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+/// Displacement voting: off, on over a given radius, or decided from the first two frames. In
+/// TOML, a number of px, `"off"` or `"auto"`.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum VoteSearch {
     /// On, searching this many px around the prediction.
     Px(f64),
@@ -82,6 +82,37 @@ pub enum VoteMode {
     Off,
     /// Measured on the first two frames of the first pass (see [`VoteSearch::AUTO`]).
     Auto,
+}
+
+impl Serialize for VoteSearch {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            VoteSearch::Px(px) => serializer.serialize_f64(*px),
+            VoteSearch::Mode(mode) => mode.serialize(serializer),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for VoteSearch {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        let expected = "a number of px, \"off\" or \"auto\"";
+        match NumberOrWord::deserialize(deserializer) {
+            Ok(NumberOrWord::Number(px)) => Ok(VoteSearch::Px(px)),
+            Ok(NumberOrWord::Word(word)) => match word.as_str() {
+                "off" => Ok(VoteSearch::OFF),
+                "auto" => Ok(VoteSearch::AUTO),
+                _ => Err(serde::de::Error::custom(format!(
+                    "expected {expected}, found \"{word}\""
+                ))),
+            },
+            Err(_) => Err(serde::de::Error::custom(format!("expected {expected}"))),
+        }
+    }
 }
 
 impl VoteSearch {
