@@ -39,15 +39,12 @@ impl<'de> Deserialize<'de> for Scale {
     fn deserialize<D: serde::Deserializer<'de>>(
         deserializer: D,
     ) -> std::result::Result<Self, D::Error> {
-        let expected = "a number of px or \"auto\"";
-        match NumberOrWord::deserialize(deserializer) {
-            Ok(NumberOrWord::Number(px)) => Ok(Scale::Px(px)),
-            Ok(NumberOrWord::Word(word)) if word == "auto" => Ok(Scale::Auto),
-            Ok(NumberOrWord::Word(word)) => Err(serde::de::Error::custom(format!(
-                "expected {expected}, found \"{word}\""
-            ))),
-            Err(_) => Err(serde::de::Error::custom(format!("expected {expected}"))),
-        }
+        NumberOrWord::read(
+            deserializer,
+            "a number of px or \"auto\"",
+            Scale::Px,
+            |word| (word == "auto").then_some(Scale::Auto),
+        )
     }
 }
 

@@ -100,18 +100,16 @@ impl<'de> Deserialize<'de> for VoteSearch {
     fn deserialize<D: serde::Deserializer<'de>>(
         deserializer: D,
     ) -> std::result::Result<Self, D::Error> {
-        let expected = "a number of px, \"off\" or \"auto\"";
-        match NumberOrWord::deserialize(deserializer) {
-            Ok(NumberOrWord::Number(px)) => Ok(VoteSearch::Px(px)),
-            Ok(NumberOrWord::Word(word)) => match word.as_str() {
-                "off" => Ok(VoteSearch::OFF),
-                "auto" => Ok(VoteSearch::AUTO),
-                _ => Err(serde::de::Error::custom(format!(
-                    "expected {expected}, found \"{word}\""
-                ))),
+        NumberOrWord::read(
+            deserializer,
+            "a number of px, \"off\" or \"auto\"",
+            VoteSearch::Px,
+            |word| match word {
+                "off" => Some(VoteSearch::OFF),
+                "auto" => Some(VoteSearch::AUTO),
+                _ => None,
             },
-            Err(_) => Err(serde::de::Error::custom(format!("expected {expected}"))),
-        }
+        )
     }
 }
 
