@@ -10,9 +10,10 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
-use sillage::bedload::fit::{config_text, read_state_tracks, tracks_without_state};
+use sillage::bedload::fit::{config_text, fit_smoother, read_state_tracks, tracks_without_state};
 use sillage::filter::fit::STATE_NAMES;
 use sillage::filter::{BedloadFit, BedloadParams, FitOptions, FitReport, fit_bedload};
+use sillage::track::bedload::{BedloadTrackerParams, EmissionParams, EmissionReport};
 
 use crate::shared_args::JsonArg;
 
@@ -33,6 +34,11 @@ pub struct FitBedloadArgs {
     /// estimate.
     #[arg(long, value_name = "P", default_value_t = FitOptions::default().min_probability)]
     pub min_probability: f64,
+    /// `sillage track bedload`'s output (BeadTracking CSV) on the frames of `--truth`: the
+    /// motion-state smoother's evidence model (`[smoother.emission]`) is then learnt from its
+    /// points paired with the truth, on the same training frames.
+    #[arg(long, value_name = "FILE")]
+    pub tracks: Option<PathBuf>,
     /// Fewest samples for a state's row or noises to be fitted; below, the default is kept.
     #[arg(long, value_name = "N", default_value_t = FitOptions::default().min_samples)]
     pub min_samples: u64,
@@ -53,6 +59,9 @@ struct JsonSummary<'a> {
     min_samples: u64,
     motion: &'a BedloadParams,
     report: &'a FitReport,
+    /// The smoother's evidence model and its samples, with `--tracks`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    emission: Option<(&'a EmissionParams, &'a EmissionReport)>,
 }
 
 /// `sillage fit bedload --truth FILE --out FILE`.
@@ -76,12 +85,32 @@ pub fn run_bedload(args: &FitBedloadArgs) -> Result<()> {
             args.truth.display()
         )
     })?;
+    let emission = match &args.tracks {
+        Some(path) => {
+            let (model, report) = fit_smoother(
+                &args.truth,
+                path,
+                fit.report.training_frames,
+                &BedloadTrackerParams::default(),
+                args.min_samples,
+            )
+            .with_context(|| {
+                format!(
+                    "cannot learn the motion-state evidence from {} (--tracks)",
+                    path.display()
+                )
+            })?;
+            Some((path.as_path(), model, report))
+        }
+        None => None,
+    };
     let text = config_text(
         &args.truth,
         &options,
         &fit,
         tracks.len(),
         tracks_without_state,
+        emission.as_ref().map(|(p, m, r)| (*p, m, r)),
     )?;
     write_config(&args.out, &text)?;
     if args.json.enabled {
@@ -95,10 +124,14 @@ pub fn run_bedload(args: &FitBedloadArgs) -> Result<()> {
             min_samples: options.min_samples,
             motion: &fit.params,
             report: &fit.report,
+            emission: emission.as_ref().map(|(_, m, r)| (m, r)),
         };
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         print!("{}", human_summary(args, &fit, tracks.len()));
+        if let Some((path, model, report)) = &emission {
+            print!("{}", emission_summary(path, model, report));
+        }
     }
     Ok(())
 }
@@ -152,6 +185,33 @@ fn human_summary(args: &FitBedloadArgs, fit: &BedloadFit, tracks: usize) -> Stri
             "kept from the defaults (fewer than {} samples): {}",
             args.min_samples,
             r.kept.join(", ")
+        );
+    }
+    s
+}
+
+/// The smoother's evidence model, one line per state.
+fn emission_summary(path: &Path, model: &EmissionParams, report: &EmissionReport) -> String {
+    let mut s = format!(
+        "motion-state evidence from {} ({} points unpaired): ln(speed + {:.4} m/s) and \
+         ln(contact ratio), mean ± sd\n",
+        path.display(),
+        report.unpaired,
+        model.speed_floor_m_per_s
+    );
+    for (state, m) in [&model.resting, &model.rolling, &model.saltating]
+        .into_iter()
+        .enumerate()
+    {
+        let _ = writeln!(
+            s,
+            "{:<10}{:>8} samples   speed {:>7.3} ± {:.3}   contact {:>7.3} ± {:.3}",
+            STATE_NAMES[state],
+            report.samples[state],
+            m.log_speed.mean,
+            m.log_speed.sd,
+            m.log_contact.mean,
+            m.log_contact.sd
         );
     }
     s

@@ -200,6 +200,9 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
         (None, Some(detections)) => read_inputs(args, detections)?,
         (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
     };
+    if let Some(total) = total {
+        params.check_sequence_length(total)?;
+    }
     let mut pipeline = Pipeline::from_config(&config)?;
     let mut writer = BeadTrackOutput::create(&args.out, output_kind(args.format), &params)?;
     let kind = writer.kind();

@@ -378,6 +378,12 @@ fn beads_with_discs_points_and_the_papers_scores() {
         "/combined/papers/motion_states/saltating/true_positives",
         88,
     );
+    // The confusion matrix (rows true, columns estimated rest/roll/salt/unknown): diagonal.
+    assert_eq!(
+        json.pointer("/combined/papers/motion_states/confusion")
+            .unwrap(),
+        &serde_json::json!([[2305, 0, 0, 0], [0, 1172, 0, 0], [0, 0, 88, 0]])
+    );
     close(&json, "/combined/papers/vace/ata", 1.0);
     close(&json, "/combined/papers/etiseo/mean", 1.0);
 

@@ -276,3 +276,57 @@ fn bad_inputs_exit_1_naming_the_file() {
     assert_eq!(output.status.code(), Some(1));
     assert!(stderr(&output).contains("no/such/folder/motion.toml"));
 }
+
+/// `--tracks`: the motion-state smoother's evidence learnt from a tracker's output paired
+/// with the truth, written under `[smoother.emission]`, which `track bedload` reads back; a
+/// lag not shorter than the sequence is refused.
+#[test]
+fn fits_the_smoother_evidence_and_the_tracker_reads_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let tracks = dir.path().join("tracks.csv");
+    let track = |extra: &[&str]| {
+        let mut args = vec![
+            "track",
+            "bedload",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../../shared/data/bedload_beads_lafaye2018/images"
+            ),
+            "--mask",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../../shared/data/bedload_beads_lafaye2018/sequence_base_mask.tif"
+            ),
+            "--out",
+            path_str(&tracks),
+        ];
+        args.extend_from_slice(extra);
+        sillage(&args)
+    };
+    let output = track(&[]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let out = dir.path().join("fit.toml");
+    let stdout = fit(TRUTH, &out, &["--tracks", path_str(&tracks)]);
+    assert!(stdout.contains("motion-state evidence from"), "{stdout}");
+    let text = fs::read_to_string(&out).unwrap();
+    assert!(
+        text.contains("[smoother.emission.rolling.log_speed]"),
+        "{text}"
+    );
+    let config: sillage::track::bedload::BedloadTrackerParams = toml::from_str(&text).unwrap();
+    config.validate().unwrap();
+    let e = &config.smoother.emission;
+    // Resting beads barely move, saltating ones fly: the learnt speeds are ordered.
+    assert!(e.resting.log_speed.mean < e.rolling.log_speed.mean);
+    assert!(e.rolling.log_speed.mean < e.saltating.log_speed.mean);
+    let output = track(&["--config", path_str(&out)]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    // Ten frames cannot hold a lag of ten.
+    let output = track(&["--set", "smoother.lag=10"]);
+    assert_eq!(output.status.code(), Some(1));
+    let message = stderr(&output);
+    assert!(
+        message.contains("`smoother.lag`") && message.contains("10 frames"),
+        "{message}"
+    );
+}

@@ -69,11 +69,10 @@ fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
     }
 }
 
-#[test]
-fn bedload_rows_of_the_real_frames_are_unchanged() {
+/// `track bedload` on the real frames; `lag` is `smoother.lag`.
+fn track_real_beads(dir: &Path, lag: u32) -> std::path::PathBuf {
     let data = format!("{SHARED}/bedload_beads_lafaye2018");
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("tracks.csv");
+    let out = dir.join(format!("tracks_lag{lag}.csv"));
     run_ok(&[
         "track",
         "bedload",
@@ -82,10 +81,27 @@ fn bedload_rows_of_the_real_frames_are_unchanged() {
         &format!("{data}/sequence_param.txt"),
         "--mask",
         &format!("{data}/sequence_base_mask.tif"),
+        "--set",
+        &format!("smoother.lag={lag}"),
         "--out",
         path_str(&out),
     ]);
-    assert_rows(&out, 0xe7a3_6120_a755_ec05, "track bedload");
+    out
+}
+
+#[test]
+fn bedload_rows_of_the_real_frames_are_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    // A lag of 0 is the frame-by-frame states of before the smoother, row for row.
+    let out = track_real_beads(dir.path(), 0);
+    assert_rows(
+        &out,
+        0xe7a3_6120_a755_ec05,
+        "track bedload, smoother.lag = 0",
+    );
+    // The default (smoothed states, lag 4), pinned when the smoother was added.
+    let out = track_real_beads(dir.path(), 4);
+    assert_rows(&out, 0x0bf4_7e17_edd5_ac6f, "track bedload");
 }
 
 /// The ground plane of PETS 2009 S2.L1, fitted from its truth.

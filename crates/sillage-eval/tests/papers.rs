@@ -12,8 +12,8 @@ use sillage_eval::mot::{
     TruthRole, clear_events, clear_mot,
 };
 use sillage_eval::papers::{
-    BedloadScores, EtiseoMetrics, PaperMetrics, PapersReport, StateLabel, bedload_scores, etiseo,
-    motion_state_scores, vace,
+    BedloadScores, EtiseoMetrics, MotionStateScores, PaperMetrics, PapersReport, StateLabel,
+    bedload_scores, etiseo, motion_state_scores, vace,
 };
 use sillage_io::{BeadCategory, BeadPoint, read_bead_csv, read_bead_sequence_params};
 
@@ -156,6 +156,8 @@ fn motion_state_scores_per_state() {
     });
     let m = motion_state_scores(&events, &truth_states, &estimate_states).unwrap();
     assert_eq!((m.evaluated, m.unknown_truth), (6, 2));
+    // Rows true rest/roll/salt, columns estimated rest/roll/salt/unknown.
+    assert_eq!(m.confusion, [[2, 1, 0, 0], [0, 1, 0, 1], [0, 0, 1, 0]]);
     let counts = |s: &sillage_eval::papers::StateScores| {
         (s.true_positives, s.false_positives, s.false_negatives)
     };
@@ -183,6 +185,95 @@ fn motion_state_scores_per_state() {
         err.to_string()
             .contains("truth id 1 has two motion states in frame 1")
     );
+}
+
+/// One true track followed by one estimate over 12 frames (R rest, L roll, S salt,
+/// ? unknown):
+///
+/// | frame | 0 | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10 | 11 |
+/// |---|---|---|---|---|---|---|---|---|---|---|---|---|
+/// | truth | ? | R | R | R | R | L | L | L | S | S | S | S |
+/// | estimate | R | R | L | L | S | L | R | ? | S | ? | L | S |
+///
+/// Frame 0 has no known true state; the other 11 fill the matrix (rows true, columns
+/// estimated rest/roll/salt/unknown): rest [1, 2, 1, 0], roll [1, 1, 0, 1], salt
+/// [0, 1, 2, 1]. TP/FP/FN are the diagonal, the rest of the column, the rest of the row:
+/// rest 1/1/3 (P 1/2, R 1/4), roll 1/3/2 (P 1/4, R 1/3), salt 2/1/2 (P 2/3, R 1/2).
+#[test]
+fn motion_state_confusion_matrix() {
+    use MotionState::{Resting as R, Rolling as L, Saltating as S, Unknown as U};
+    let (data, events) = events_of(&truth(1, 0, 0..12), &estimate(9, 0, 0..12));
+    let truth_states = labels(1, &[U, R, R, R, R, L, L, L, S, S, S, S]);
+    let estimate_states = labels(9, &[R, R, L, L, S, L, R, U, S, U, L, S]);
+    let m = motion_state_scores(&events, &truth_states, &estimate_states).unwrap();
+    let matrix = [[1, 2, 1, 0], [1, 1, 0, 1], [0, 1, 2, 1]];
+    assert_eq!(m.confusion, matrix);
+    assert_eq!((m.evaluated, m.unknown_truth), (11, 1));
+    let counts = |s: &sillage_eval::papers::StateScores| {
+        (s.true_positives, s.false_positives, s.false_negatives)
+    };
+    assert_eq!(counts(&m.resting), (1, 1, 3));
+    assert_eq!(counts(&m.rolling), (1, 3, 2));
+    assert_eq!(counts(&m.saltating), (2, 1, 2));
+    close("rest P", m.resting.precision.unwrap(), 1.0 / 2.0);
+    close("rest R", m.resting.recall.unwrap(), 1.0 / 4.0);
+    close("roll P", m.rolling.precision.unwrap(), 1.0 / 4.0);
+    close("roll R", m.rolling.recall.unwrap(), 1.0 / 3.0);
+    close("salt P", m.saltating.precision.unwrap(), 2.0 / 3.0);
+    close("salt R", m.saltating.recall.unwrap(), 1.0 / 2.0);
+
+    // Precision and recall agree with the matrix: diagonal over its column, over its row.
+    let agree = |m: &sillage_eval::papers::MotionStateScores| {
+        for (c, (_, s)) in m.by_state().into_iter().enumerate() {
+            let diagonal = m.confusion[c][c] as f64;
+            let column: u64 = m.confusion.iter().map(|row| row[c]).sum();
+            let row: u64 = m.confusion[c].iter().sum();
+            close("precision", s.precision.unwrap(), diagonal / column as f64);
+            close("recall", s.recall.unwrap(), diagonal / row as f64);
+        }
+    };
+    agree(&m);
+
+    // Combining sums the matrices (and scores from the sum): with a perfect sequence of
+    // one of each state.
+    let (_, perfect_events) = events_of(&truth(1, 0, 0..4), &estimate(9, 0, 0..4));
+    let perfect = motion_state_scores(
+        &perfect_events,
+        &labels(1, &[U, R, L, S]),
+        &labels(9, &[U, R, L, S]),
+    )
+    .unwrap();
+    assert_eq!(
+        perfect.confusion,
+        [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]
+    );
+    let both = MotionStateScores::combine(&[m, perfect, m]);
+    assert_eq!(both.confusion, [[3, 4, 2, 0], [2, 3, 0, 2], [0, 2, 5, 2]]);
+    assert_eq!((both.evaluated, both.unknown_truth), (25, 3));
+    assert_eq!(counts(&both.rolling), (3, 6, 4));
+    agree(&both);
+
+    // The text report prints the matrix of each sequence, then COMBINED's.
+    let metrics =
+        PaperMetrics::new(&data, &events, Some((&truth_states, &estimate_states))).unwrap();
+    let text = PapersReport::new(vec![("a".into(), metrics)]).to_string();
+    let expected = "\
+Motion-state confusion (rows: true state, columns: estimated state; matched points)
+sequence  true  rest  roll  salt  unknown
+a         rest     1     2     1        0
+          roll     1     1     0        1
+          salt     0     1     2        1
+COMBINED  rest     1     2     1        0
+          roll     1     1     0        1
+          salt     0     1     2        1
+";
+    assert!(text.contains(expected), "{text}");
+    let (states, vace) = (
+        text.find("Motion states").unwrap(),
+        text.find("VACE").unwrap(),
+    );
+    let confusion = text.find("Motion-state confusion").unwrap();
+    assert!(states < confusion && confusion < vace, "{text}");
 }
 
 /// Truth 1, 2 and estimates 10, 20, 30 with these overlaps (similarities):
@@ -286,7 +377,7 @@ fn report_tables() {
         assert!(text.contains(expected), "{text}");
     }
     assert!(
-        !text.contains("Motion states"),
+        !text.contains("Motion states") && !text.contains("confusion"),
         "no states were given: {text}"
     );
     assert_eq!(report.combined.bedload.truth_tracks, 2);
@@ -371,6 +462,10 @@ fn real_bead_ground_truth() {
             m.saltating.true_positives
         ),
         (2305, 1172, 88)
+    );
+    assert_eq!(
+        m.confusion,
+        [[2305, 0, 0, 0], [0, 1172, 0, 0], [0, 0, 88, 0]]
     );
     assert_eq!((p.vace.sfda, p.vace.ata, p.etiseo.mean), (1.0, 1.0, 1.0));
 

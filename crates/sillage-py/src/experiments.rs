@@ -54,7 +54,7 @@ fn fit_bedload_file(truth: &Path, out: Option<&Path>) -> Result<String> {
     let tracks = read_state_tracks(truth)?;
     let without = tracks_without_state(&tracks);
     let fit = fit_bedload(&tracks, &BedloadParams::default(), &options)?;
-    let text = config_text(truth, &options, &fit, tracks.len(), without)?;
+    let text = config_text(truth, &options, &fit, tracks.len(), without, None)?;
     if let Some(path) = out {
         write_text(path, &text)?;
     }

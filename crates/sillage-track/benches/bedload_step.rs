@@ -131,6 +131,12 @@ fn trackers(c: &mut Criterion) {
             };
             (kind.name().to_string(), params, 400)
         })
+        .chain(std::iter::once({
+            // The states frame by frame (the paper), to show the smoother's cost.
+            let mut params = BedloadTrackerParams::default();
+            params.smoother.lag = 0;
+            ("mmpf_plus_lag0".to_string(), params, 400)
+        }))
         .collect();
     bench_step(c, "bedload_trackers", &cases);
 }

@@ -173,6 +173,16 @@ pub struct StateScores {
 }
 
 impl StateScores {
+    /// The scores of the state in row and column `c` of a confusion matrix (see
+    /// [`MotionStateScores::confusion`]): TP its diagonal cell, FP the rest of its column, FN
+    /// the rest of its row (the unknown column included).
+    fn from_confusion(confusion: &[[u64; 4]; 3], c: usize) -> Self {
+        let tp = confusion[c][c];
+        let fp = confusion.iter().map(|row| row[c]).sum::<u64>() - tp;
+        let fn_ = confusion[c].iter().sum::<u64>() - tp;
+        Self::from_counts([tp, fp, fn_])
+    }
+
     fn from_counts([tp, fp, fn_]: [u64; 3]) -> Self {
         let ratio = |den: u64| (den > 0).then(|| tp as f64 / den as f64);
         let (precision, recall) = (ratio(tp + fp), ratio(tp + fn_));
@@ -189,14 +199,6 @@ impl StateScores {
             recall,
             f_score,
         }
-    }
-
-    fn counts(&self) -> [u64; 3] {
-        [
-            self.true_positives,
-            self.false_positives,
-            self.false_negatives,
-        ]
     }
 }
 
@@ -215,9 +217,14 @@ pub struct MotionStateScores {
     pub rolling: StateScores,
     /// Saltating.
     pub saltating: StateScores,
+    /// Confusion matrix of the matched points whose true state is known (`evaluated` in
+    /// all): rows are the true state (resting, rolling, saltating), columns the estimated
+    /// state (resting, rolling, saltating, unknown). The per-state scores are read off it.
+    pub confusion: [[u64; 4]; 3],
 }
 
-/// The three states scored, in table order.
+/// The three states scored, in table order (rows of the confusion matrix; its columns add
+/// unknown).
 const STATES: [MotionState; 3] = [
     MotionState::Resting,
     MotionState::Rolling,
@@ -227,12 +234,13 @@ const STATES: [MotionState; 3] = [
 /// Scores the estimated motion states of the points matched by CLEAR MOT (`events`, from
 /// the same sequence as the labels) against the true ones (MMPF+ paper §5.3, Fig. 7).
 ///
-/// Each matched point is one classification sample; for each state `c`, a sample whose true
-/// state is `c` is a true positive when estimated `c` and a false negative otherwise (an
-/// estimate in no state included); a sample estimated `c` whose true state is another is a
-/// false positive. Samples whose true state is unknown are left out (counted in
-/// `unknown_truth`); unmatched points carry no state comparison. An object without a label
-/// has an unknown state. A label given twice for the same object and frame is an error.
+/// Each matched point is one classification sample, counted in the confusion matrix by its
+/// true and estimated state; for each state `c`, a sample whose true state is `c` is a true
+/// positive when estimated `c` and a false negative otherwise (an estimate in no state
+/// included); a sample estimated `c` whose true state is another is a false positive.
+/// Samples whose true state is unknown are left out (counted in `unknown_truth`); unmatched
+/// points carry no state comparison. An object without a label has an unknown state. A
+/// label given twice for the same object and frame is an error.
 pub fn motion_state_scores(
     events: &[FrameEvents],
     truth: &[StateLabel],
@@ -247,30 +255,19 @@ pub fn motion_state_scores(
             .unwrap_or(MotionState::Unknown)
     };
     let slot = |s: MotionState| STATES.iter().position(|&c| c == s);
-    let mut counts = [[0u64; 3]; 3];
-    let (mut evaluated, mut unknown_truth) = (0, 0);
+    let mut confusion = [[0u64; 4]; 3];
+    let mut unknown_truth = 0;
     for frame in events {
         for m in &frame.matches {
             let Some(t) = slot(state(&truth_states, frame.frame, m.truth_id)) else {
                 unknown_truth += 1;
                 continue;
             };
-            evaluated += 1;
-            match slot(state(&estimate_states, frame.frame, m.estimate_id)) {
-                Some(e) if e == t => counts[t][0] += 1,
-                Some(e) => {
-                    counts[e][1] += 1;
-                    counts[t][2] += 1;
-                }
-                None => counts[t][2] += 1,
-            }
+            let e = slot(state(&estimate_states, frame.frame, m.estimate_id));
+            confusion[t][e.unwrap_or(STATES.len())] += 1;
         }
     }
-    Ok(MotionStateScores::from_counts(
-        evaluated,
-        unknown_truth,
-        counts,
-    ))
+    Ok(MotionStateScores::from_confusion(unknown_truth, confusion))
 }
 
 /// The labels by (frame, id); a pair given twice is an error.
@@ -289,13 +286,15 @@ fn state_index(what: &str, labels: &[StateLabel]) -> Result<IdMap<(FrameIndex, u
 }
 
 impl MotionStateScores {
-    fn from_counts(evaluated: u64, unknown_truth: u64, counts: [[u64; 3]; 3]) -> Self {
+    /// The scores of a confusion matrix, all derived from it.
+    fn from_confusion(unknown_truth: u64, confusion: [[u64; 4]; 3]) -> Self {
         Self {
-            evaluated,
+            evaluated: confusion.iter().flatten().sum(),
             unknown_truth,
-            resting: StateScores::from_counts(counts[0]),
-            rolling: StateScores::from_counts(counts[1]),
-            saltating: StateScores::from_counts(counts[2]),
+            resting: StateScores::from_confusion(&confusion, 0),
+            rolling: StateScores::from_confusion(&confusion, 1),
+            saltating: StateScores::from_confusion(&confusion, 2),
+            confusion,
         }
     }
 
@@ -308,20 +307,20 @@ impl MotionStateScores {
         ]
     }
 
-    /// Combines sequences: sums the counts, then recomputes the scores.
+    /// Combines sequences: sums the confusion matrices (and the unknown truths), then
+    /// recomputes the scores.
     pub fn combine(sequences: &[MotionStateScores]) -> MotionStateScores {
-        let mut counts = [[0u64; 3]; 3];
+        let mut confusion = [[0u64; 4]; 3];
         for s in sequences {
-            for (total, (_, state)) in counts.iter_mut().zip(s.by_state()) {
-                for (t, c) in total.iter_mut().zip(state.counts()) {
+            for (total, row) in confusion.iter_mut().zip(&s.confusion) {
+                for (t, c) in total.iter_mut().zip(row) {
                     *t += c;
                 }
             }
         }
-        MotionStateScores::from_counts(
-            sequences.iter().map(|s| s.evaluated).sum(),
+        MotionStateScores::from_confusion(
             sequences.iter().map(|s| s.unknown_truth).sum(),
-            counts,
+            confusion,
         )
     }
 
@@ -346,11 +345,40 @@ impl MotionStateScores {
             ("F(salt)", optional_score(salt.f_score)),
         ]
     }
+
+    /// The heading of its confusion tables.
+    pub(crate) fn confusion_title(&self) -> String {
+        "Motion-state confusion (rows: true state, columns: estimated state; matched points)"
+            .to_owned()
+    }
+
+    /// The column names of a confusion table after the leading ones: the estimated states.
+    pub(crate) const CONFUSION_COLUMNS: [&'static str; 4] = ["rest", "roll", "salt", "unknown"];
+
+    /// The confusion matrix as table rows: the true state's short name, then the counts of
+    /// each estimated state ([`Self::CONFUSION_COLUMNS`]).
+    pub(crate) fn confusion_rows(&self) -> impl Iterator<Item = Vec<String>> + '_ {
+        Self::CONFUSION_COLUMNS
+            .iter()
+            .zip(&self.confusion)
+            .map(|(name, row)| {
+                std::iter::once((*name).to_owned())
+                    .chain(row.iter().map(|&n| count(n)))
+                    .collect()
+            })
+    }
 }
 
 impl std::fmt::Display for MotionStateScores {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(f, "{}", self.title())?;
-        Table::single(&self.columns()).fmt(f)
+        Table::single(&self.columns()).fmt(f)?;
+        writeln!(f, "\n{}", self.confusion_title())?;
+        let header = std::iter::once("true").chain(Self::CONFUSION_COLUMNS);
+        let mut table = Table::new(header.map(str::to_owned));
+        for row in self.confusion_rows() {
+            table.push(row);
+        }
+        table.fmt(f)
     }
 }

@@ -13,7 +13,7 @@ use super::bedload::{
 use super::etiseo::{EtiseoMetrics, etiseo};
 use super::vace::{VaceMetrics, vace};
 use crate::mot::{FrameEvents, MotData};
-use crate::summary::{FamilyColumns, family_tables};
+use crate::summary::{FamilyColumns, Table, family_tables};
 
 /// Every paper's own scores of one sequence (or of several combined).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -102,8 +102,39 @@ impl fmt::Display for PapersReport {
         if let Some(states) = &c.motion_states {
             families.push((states.title(), |m| m.motion_states.map(|s| s.columns())));
         }
-        families.push((c.vace.title(), |m| Some(m.vace.columns())));
-        families.push((c.etiseo.title(), |m| Some(m.etiseo.columns())));
-        family_tables(f, &rows, &families)
+        family_tables(f, &rows, &families)?;
+        if let Some(states) = &c.motion_states {
+            writeln!(f, "\n{}", states.confusion_title())?;
+            write!(f, "{}", confusion_table(&rows))?;
+        }
+        writeln!(f)?;
+        family_tables(
+            f,
+            &rows,
+            &[
+                (c.vace.title(), |m| Some(m.vace.columns())),
+                (c.etiseo.title(), |m| Some(m.etiseo.columns())),
+            ],
+        )
     }
+}
+
+/// The confusion matrices of the rows that have motion states, one after the other: the
+/// sequence's name on its first line, then the true state and the counts of each estimated
+/// state.
+fn confusion_table(rows: &[(&str, &PaperMetrics)]) -> Table {
+    let header = ["sequence", "true"]
+        .into_iter()
+        .chain(MotionStateScores::CONFUSION_COLUMNS);
+    let mut table = Table::new(header.map(str::to_owned));
+    for (name, m) in rows {
+        let Some(states) = &m.motion_states else {
+            continue;
+        };
+        for (i, row) in states.confusion_rows().enumerate() {
+            let label = if i == 0 { *name } else { "" };
+            table.push(std::iter::once(label.to_owned()).chain(row));
+        }
+    }
+    table
 }

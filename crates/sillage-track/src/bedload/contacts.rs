@@ -77,6 +77,27 @@ impl Contacts {
         });
         n
     }
+
+    /// The centre distance from a bead of class `class` at `p` to the nearest indexed bead
+    /// (not `exclude`) over the sum of their radii (1 = touching), capped at `cap`.
+    pub fn nearest_ratio(
+        &self,
+        p: Point2,
+        class: ObjectClass,
+        exclude: Option<usize>,
+        radii: &[f64],
+        cap: f64,
+    ) -> f64 {
+        let own = radius_of(radii, class);
+        let mut best = cap;
+        self.index
+            .for_each_within(p, cap * (own + self.max_radius_px), |j, d2| {
+                if Some(j) != exclude {
+                    best = best.min(d2.sqrt() / (own + radius_of(radii, self.classes[j])));
+                }
+            });
+        best
+    }
 }
 
 /// The radius of `class`, or of the last class listed for classes beyond the list.
@@ -130,5 +151,16 @@ mod tests {
         assert_eq!(contacts.count(beads[0].0, 0, None, &radii, 1.07), 3);
         // The transparent bead at (0, 26) touches the black one only.
         assert_eq!(contacts.count(beads[2].0, 1, Some(2), &radii, 1.07), 1);
+        // Nearest to the black bead at the origin by ratio: the black one at 31 px, 31/30
+        // (the transparent one at 26 px is 26/25).
+        let ratio = contacts.nearest_ratio(beads[0].0, 0, Some(0), &radii, 2.0);
+        assert!((ratio - 31.0 / 30.0).abs() < 1e-12, "{ratio}");
+        // Alone, the cap.
+        let mut alone = Contacts::default();
+        alone.rebuild([(Point2::new(0.0, 0.0), 0)].into_iter(), &radii);
+        assert_eq!(
+            alone.nearest_ratio(Point2::new(0.0, 0.0), 0, Some(0), &radii, 2.0),
+            2.0
+        );
     }
 }

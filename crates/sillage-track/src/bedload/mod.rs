@@ -34,6 +34,8 @@
 //!     };
 //!     tracker.step(&FrameObservations::from_detections(frame, &detections), &mut points)?;
 //! }
+//! // The states are smoothed over `smoother.lag` frames: the last points come at the end.
+//! tracker.finish(&mut points)?;
 //! // One trajectory through the two missed frames, its positions estimated there.
 //! assert_eq!(points.len(), 6);
 //! assert!(points.iter().all(|p| p.track_id == 1));
@@ -47,10 +49,15 @@ mod contacts;
 mod filters;
 mod params;
 mod particle;
+mod smoother;
 mod tracker;
 
 pub use params::{
     AssociationParams, BedloadTrackerKind, BedloadTrackerParams, ConfidenceSet, LikelihoodParams,
     ObservedVelocity, Prediction, StateParams, SurvivalParams,
+};
+pub use smoother::{
+    CONTACT_RATIO_CAP, EmissionParams, EmissionReport, LabelledPoint, LogGaussian, MAX_LAG,
+    SmootherParams, StateEmission, fit_emission,
 };
 pub use tracker::{BedloadStats, BedloadTracker};

@@ -8,6 +8,7 @@ use sillage_core::{Calibration, Error, Result};
 use sillage_filter::{BedloadModel, BedloadParams, FilterParams, FilterSpec, PositionMeasurement};
 
 use crate::bedload::contacts::StateRule;
+use crate::bedload::smoother::{Smoother, SmootherParams};
 
 /// Which tracker of Table 1 of the MMPF+ paper runs; all share the association, the
 /// motion-state measurement and the parameters.
@@ -240,6 +241,8 @@ pub struct BedloadTrackerParams {
     pub states: StateParams,
     /// Survival without detection.
     pub survival: SurvivalParams,
+    /// Motion states smoothed over the trajectory (fixed lag).
+    pub smoother: SmootherParams,
     /// Particles per tracker and resampling.
     pub filter: FilterParams,
     /// Motion models of Eq. (3), their switching and noises (`sillage fit bedload` writes
@@ -263,6 +266,7 @@ impl Default for BedloadTrackerParams {
             likelihood: LikelihoodParams::default(),
             states: StateParams::default(),
             survival: SurvivalParams::default(),
+            smoother: SmootherParams::default(),
             filter: FilterParams::default(),
             motion: BedloadParams::default(),
         }
@@ -280,6 +284,8 @@ pub(crate) struct Settings {
     pub likelihood: LikelihoodParams,
     pub rule: StateRule,
     pub survival: SurvivalParams,
+    /// `None` when the lag is 0 (states frame by frame).
+    pub smoother: Option<Box<Smoother>>,
     pub spec: FilterSpec,
     pub model: BedloadModel,
     pub measurement: PositionMeasurement,
@@ -316,6 +322,22 @@ impl BedloadTrackerParams {
     /// Checks every value and converts to px and px/frame; errors name the key.
     pub fn validate(&self) -> Result<()> {
         self.settings().map(drop)
+    }
+
+    /// Checks that a sequence of `frames` frames is longer than the smoother's lag (a lag
+    /// that spans the whole sequence would wait for frames that never come); the error
+    /// names `smoother.lag` and the fix.
+    pub fn check_sequence_length(&self, frames: usize) -> Result<()> {
+        let lag = self.smoother.lag as usize;
+        check(
+            lag == 0 || lag < frames,
+            "smoother.lag",
+            lag,
+            &format!(
+                "is not shorter than the sequence ({frames} frames); set smoother.lag below \
+                 {frames} (a few frames suffice), or 0 to decide the states frame by frame"
+            ),
+        )
     }
 
     pub(crate) fn settings(&self) -> Result<Settings> {
@@ -356,6 +378,10 @@ impl BedloadTrackerParams {
         finite_non_negative("states.speed_salt_m_per_s", s.speed_salt_m_per_s)?;
         finite_positive("states.contact_factor", s.contact_factor)?;
         let spec = FilterSpec::new(&self.filter, self.seed).map_err(|e| e.in_section("filter"))?;
+        let smoother = self
+            .smoother
+            .smoother(&self.motion.transition, c)?
+            .map(Box::new);
         let model = BedloadModel::new(self.motion.clone()).map_err(|e| e.in_section("motion"))?;
         let variance = l.position_variance_px2;
         let measurement = PositionMeasurement::new(
@@ -378,6 +404,7 @@ impl BedloadTrackerParams {
                 contact_factor: s.contact_factor,
             },
             survival: self.survival.clone(),
+            smoother,
             spec,
             model,
             measurement,
@@ -421,6 +448,44 @@ mod tests {
             let e = params.validate().unwrap_err().to_string();
             assert!(e.contains(key), "{key}: {e}");
         }
+    }
+
+    #[test]
+    fn smoother_settings_are_checked_naming_the_key() {
+        let mut params = BedloadTrackerParams::default();
+        params.motion.transition[1] = [0.0; 3];
+        let e = params.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("`motion.transition[1]`") && e.contains("row of zeros"),
+            "{e}"
+        );
+        let mut params = BedloadTrackerParams::default();
+        params.smoother.emission.rolling.log_speed.sd = 0.0;
+        let e = params.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("`smoother.emission.rolling.log_speed.sd`"),
+            "{e}"
+        );
+        let mut params = BedloadTrackerParams::default();
+        params.smoother.lag = 10;
+        params.check_sequence_length(11).unwrap();
+        let e = params.check_sequence_length(10).unwrap_err().to_string();
+        assert!(
+            e.contains("`smoother.lag`") && e.contains("10 frames"),
+            "{e}"
+        );
+        params.smoother.lag = 0;
+        params.check_sequence_length(1).unwrap();
+        params.smoother.lag = crate::bedload::smoother::MAX_LAG + 1;
+        let e = params.validate().unwrap_err().to_string();
+        assert!(e.contains("`smoother.lag`"), "{e}");
+        assert!(
+            BedloadTrackerParams::default()
+                .settings()
+                .unwrap()
+                .smoother
+                .is_some()
+        );
     }
 
     #[test]

@@ -17,6 +17,7 @@ use crate::bedload::params::{
     BedloadTrackerKind, BedloadTrackerParams, ObservedVelocity, Prediction, Settings,
 };
 use crate::bedload::particle::{ParticleMotion, Weighting};
+use crate::bedload::smoother::{CONTACT_RATIO_CAP, Evidence, StateChain};
 
 /// Counts over a run, for reports and tests.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -53,9 +54,11 @@ struct Track {
     spread_px: Option<f64>,
     /// The birth point, emitted on confirmation.
     birth: TrackPoint,
-    /// Points predicted through the current run of misses, held until a detection confirms
-    /// them (unless `emit_predictions_at_once`).
-    held: Vec<TrackPoint>,
+    /// Points predicted through the current run of misses, with their state evidence, held
+    /// until a detection confirms them (unless `emit_predictions_at_once`).
+    held: Vec<(TrackPoint, Evidence)>,
+    /// Emitted points whose smoothed state is not final yet (with a smoother).
+    chain: StateChain,
     /// Still tracked after this frame.
     alive: bool,
 }
@@ -66,7 +69,9 @@ struct Track {
 ///
 /// Each frame's points are emitted at that frame's step; a tracker's first point is emitted
 /// when a second detection confirms it, so a batch may also hold points of the previous frame.
-/// The output is identical for any number of threads.
+/// With a smoother (`smoother.lag` > 0) a point is emitted `lag` frames later, when its state
+/// is final, and the rest at the end of its trajectory or at [`Tracker::finish`]. The output
+/// is identical for any number of threads.
 #[derive(Debug, Clone)]
 pub struct BedloadTracker {
     settings: Settings,
@@ -311,6 +316,13 @@ impl BedloadTracker {
             radii,
         );
         self.emitted.clear();
+        let smoother = self.settings.smoother.as_deref();
+        for track in self.tracks.iter_mut().filter(|t| !t.alive) {
+            // A trajectory that ends: its pending states are decided on what it has.
+            if let Some(smoother) = smoother {
+                smoother.flush(&mut track.chain, &mut self.emitted);
+            }
+        }
         for (live, track) in self.tracks.iter_mut().filter(|t| t.alive).enumerate() {
             let n = self.contacts.count(
                 track.pos_px,
@@ -321,6 +333,21 @@ impl BedloadTracker {
             );
             let speed = track.vel_px_per_frame.map_or(0.0, Vec2::norm);
             track.state = rule.state(n, speed);
+            let evidence = smoother.map(|s| {
+                let ratio = self.contacts.nearest_ratio(
+                    track.pos_px,
+                    track.class,
+                    Some(live),
+                    radii,
+                    CONTACT_RATIO_CAP,
+                );
+                s.evidence(speed, ratio)
+            });
+            let mut out = Emit {
+                smoother,
+                chain: &mut track.chain,
+                emitted: &mut self.emitted,
+            };
             let track_id = match track.track_id {
                 Some(id) => id,
                 None => {
@@ -328,10 +355,13 @@ impl BedloadTracker {
                     self.next_track_id += 1;
                     self.stats.tracks += 1;
                     track.track_id = Some(id);
-                    self.emitted.push(TrackPoint {
-                        track_id: id,
-                        ..track.birth
-                    });
+                    out.push(
+                        TrackPoint {
+                            track_id: id,
+                            ..track.birth
+                        },
+                        None,
+                    );
                     id
                 }
             };
@@ -343,10 +373,12 @@ impl BedloadTracker {
                 ..TrackPoint::at(frame, track_id, track.pos_px)
             };
             if track.misses > 0 && !self.settings.emit_predictions_at_once {
-                track.held.push(point);
+                track.held.push((point, evidence));
             } else {
-                self.emitted.append(&mut track.held);
-                self.emitted.push(point);
+                for (held, evidence) in track.held.drain(..) {
+                    out.push(held, evidence);
+                }
+                out.push(point, evidence);
             }
         }
         self.tracks.retain(|t| t.alive);
@@ -375,6 +407,7 @@ impl BedloadTracker {
                 misses: 0,
                 spread_px: None,
                 held: Vec::new(),
+                chain: StateChain::default(),
                 birth: TrackPoint {
                     class: detection.class,
                     ..TrackPoint::at(frame, 0, pos_px)
@@ -387,6 +420,23 @@ impl BedloadTracker {
             Ok(())
         } else {
             sink.accept(&self.emitted)
+        }
+    }
+}
+
+/// Where a tracker's confirmed points go: through its state chain when smoothing, else
+/// straight out.
+struct Emit<'a> {
+    smoother: Option<&'a crate::bedload::smoother::Smoother>,
+    chain: &'a mut StateChain,
+    emitted: &'a mut Vec<TrackPoint>,
+}
+
+impl Emit<'_> {
+    fn push(&mut self, point: TrackPoint, evidence: Evidence) {
+        match self.smoother {
+            Some(smoother) => smoother.push(self.chain, point, evidence, self.emitted),
+            None => self.emitted.push(point),
         }
     }
 }
@@ -422,9 +472,21 @@ impl Tracker for BedloadTracker {
         Ok(())
     }
 
-    fn finish(&mut self, _sink: &mut dyn TrackSink) -> Result<()> {
-        // Every point is emitted at its frame; unconfirmed trackers are not trajectories.
+    fn finish(&mut self, sink: &mut dyn TrackSink) -> Result<()> {
+        // Unconfirmed trackers are not trajectories; points held through misses stay
+        // unconfirmed; the smoothed states still pending are decided on what came.
+        self.emitted.clear();
+        if let Some(smoother) = self.settings.smoother.as_deref() {
+            for track in &mut self.tracks {
+                smoother.flush(&mut track.chain, &mut self.emitted);
+            }
+        }
         self.tracks.clear();
-        Ok(())
+        self.emitted.sort_unstable_by_key(|p| (p.frame, p.track_id));
+        if self.emitted.is_empty() {
+            Ok(())
+        } else {
+            sink.accept(&self.emitted)
+        }
     }
 }

@@ -1,7 +1,8 @@
 //! The bedload particle filter's motion parameters learnt from BeadTracking ground truth
 //! (the transition table of the MMPF+ paper's Eqs. (11)-(12) and the process noises of
-//! Eq. (3), §4.3), and the TOML config text that records them under `[motion]`, which the
-//! trackers read.
+//! Eq. (3), §4.3), the evidence model of the motion-state smoother learnt from a tracker's
+//! output paired with that truth, and the TOML config text that records them under `[motion]`
+//! and `[smoother.emission]`, which the trackers read.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -11,11 +12,56 @@ use sillage_core::{Error, MotionState, Result, Vec2};
 use sillage_filter::fit::STATE_NAMES;
 use sillage_filter::{BedloadFit, BedloadParams, FitOptions, StatePoint, StateTrack};
 use sillage_io::read_bead_csv;
+use sillage_track::bedload::{
+    BedloadTrackerParams, EmissionParams, EmissionReport, LabelledPoint, fit_emission,
+};
 
-/// The config file: the fitted parameters under `[motion]`.
+/// The config file: the fitted parameters under `[motion]`, and the smoother's evidence
+/// model under `[smoother.emission]` when it was fitted.
 #[derive(Serialize)]
 struct ConfigFile<'a> {
     motion: &'a BedloadParams,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    smoother: Option<SmootherSection<'a>>,
+}
+
+/// `[smoother]` with only its evidence model (the lag keeps its default).
+#[derive(Serialize)]
+struct SmootherSection<'a> {
+    emission: &'a EmissionParams,
+}
+
+/// The points of a BeadTracking CSV (a truth or `sillage track bedload`'s output) as the
+/// smoother's fit reads them: the speed is the file's `vx, vy`.
+pub fn read_labelled_points(path: &Path) -> Result<Vec<LabelledPoint>> {
+    Ok(read_bead_csv(path)?
+        .iter()
+        .map(|p| LabelledPoint::of(&p.track_point()))
+        .collect())
+}
+
+/// The smoother's evidence model learnt from a tracker's output (`tracks`) and the truth
+/// with states (`truth`) over the training frames `frames`, with the bead radii and the
+/// calibration of `params`; a state with fewer than `min_samples` samples keeps the default.
+pub fn fit_smoother(
+    truth: &Path,
+    tracks: &Path,
+    frames: [u64; 2],
+    params: &BedloadTrackerParams,
+    min_samples: u64,
+) -> Result<(EmissionParams, EmissionReport)> {
+    let truth_points = read_labelled_points(truth)?;
+    let track_points = read_labelled_points(tracks)?;
+    fit_emission(
+        &track_points,
+        &truth_points,
+        frames,
+        &params.radius_px,
+        &params.calibration,
+        &params.smoother.emission,
+        min_samples,
+    )
+    .map_err(|e| Error::input(format!("{}: {e}", truth.display())))
 }
 
 /// Reads a BeadTracking CSV and groups its points by bead id, frames increasing; an id given
@@ -70,6 +116,7 @@ pub fn config_text(
     fit: &BedloadFit,
     tracks: usize,
     tracks_without_state: usize,
+    emission: Option<(&Path, &EmissionParams, &EmissionReport)>,
 ) -> Result<String> {
     let r = &fit.report;
     let mut text = String::new();
@@ -124,8 +171,18 @@ pub fn config_text(
          keys are the defaults: set flow_vel_px_per_frame for your sequence"
             .into(),
     );
+    if let Some((tracks_file, _, report)) = emission {
+        line(format!(
+            "[smoother.emission] from the tracker's points of {} paired with the truth in the \
+             training frames: {} ({} unpaired)",
+            tracks_file.display(),
+            per_state(|s| report.samples[s].to_string()),
+            report.unpaired
+        ));
+    }
     let body = toml::to_string(&ConfigFile {
         motion: &fit.params,
+        smoother: emission.map(|(_, emission, _)| SmootherSection { emission }),
     })
     .map_err(|e| Error::input(format!("cannot write the fitted parameters as TOML: {e}")))?;
     Ok(format!("{text}\n{body}"))

@@ -1,0 +1,630 @@
+//! Motion states decided over the trajectory: a fixed-lag forward–backward smoother over the
+//! jump-Markov chain of the MMPF+ paper (the transition table π of Eq. (12), `[motion]`), with
+//! per-frame evidence from the bead's observed speed `|u_obs|` (§3.4.2) and its contact with
+//! the nearest bead (Eq. (4)'s contacts, as a distance ratio). Each point waits `lag` frames
+//! of its trajectory; its state is then the most probable one given everything up to `lag`
+//! frames after it. The emission model is learnt from ground truth with states
+//! ([`fit_emission`], `sillage fit bedload --tracks`).
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+use sillage_core::{Calibration, Error, MotionState, Result, TrackPoint};
+
+/// A Gaussian over one log-feature of one state.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LogGaussian {
+    /// Mean of the natural logarithm of the feature.
+    pub mean: f64,
+    /// Standard deviation of that logarithm, > 0.
+    pub sd: f64,
+}
+
+impl LogGaussian {
+    /// The log-density of `x` (a logarithm already), up to the constant `−½ ln 2π`.
+    fn log_density(&self, x: f64) -> f64 {
+        let z = (x - self.mean) / self.sd;
+        -0.5 * z * z - self.sd.ln()
+    }
+
+    /// Mean and standard deviation of `values`, the deviation floored at `min_sd`; `None`
+    /// without values.
+    fn fit(values: &[f64], min_sd: f64) -> Option<Self> {
+        if values.is_empty() {
+            return None;
+        }
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+        Some(Self {
+            mean,
+            sd: var.sqrt().max(min_sd),
+        })
+    }
+}
+
+/// What one motion state looks like in the evidence of one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StateEmission {
+    /// `ln(|u| + speed_floor)`, the observed speed `|u|` in m/s.
+    pub log_speed: LogGaussian,
+    /// `ln(d / (r_i + r_j))`: the centre distance to the nearest bead over the sum of the
+    /// two radii (1 = touching; capped at [`CONTACT_RATIO_CAP`]).
+    pub log_contact: LogGaussian,
+}
+
+/// The evidence model of the smoother, in physical units.
+///
+/// The defaults were learnt by [`fit_emission`] on frames 1–5 of the authors' ten real
+/// flume frames (`shared/data/bedload_beads_lafaye2018`, MMPF+ tracks from our detector,
+/// 1,755 matched points with a known state); scored on frames 6–10 only, not used to learn
+/// them, they give F-scores resting / rolling / saltating of 0.89 / 0.70 / 0.88 against
+/// 0.87 / 0.58 / 0.90 for the frame-by-frame Eq. (4) (`docs/bedload.md`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EmissionParams {
+    /// Added to the speed before its logarithm, m/s: speeds well below it look alike
+    /// (default 0.0013 m/s, 0.05 px/frame on the default calibration — below the jitter of
+    /// the position estimates).
+    pub speed_floor_m_per_s: f64,
+    /// Resting.
+    pub resting: StateEmission,
+    /// Rolling.
+    pub rolling: StateEmission,
+    /// Saltating.
+    pub saltating: StateEmission,
+}
+
+impl Default for EmissionParams {
+    fn default() -> Self {
+        let state = |speed: (f64, f64), contact: (f64, f64)| StateEmission {
+            log_speed: LogGaussian {
+                mean: speed.0,
+                sd: speed.1,
+            },
+            log_contact: LogGaussian {
+                mean: contact.0,
+                sd: contact.1,
+            },
+        };
+        Self {
+            speed_floor_m_per_s: 0.05 * 2.056e-4 * 130.0,
+            resting: state((-6.244, 0.611), (-0.136, 0.108)),
+            rolling: state((-4.383, 1.600), (-0.101, 0.098)),
+            saltating: state((-1.155, 0.307), (0.149, 0.154)),
+        }
+    }
+}
+
+/// The largest contact ratio the evidence uses: a bead with no other bead within twice the
+/// contact distance counts as at twice the contact distance.
+pub const CONTACT_RATIO_CAP: f64 = 2.0;
+
+/// The `[smoother]` section: fixed-lag smoothing of the motion states.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SmootherParams {
+    /// Frames a point waits for the ones after it before its state is final. 0 gives the
+    /// frame-by-frame state of Eq. (4) (the paper's §3.5.3). Default 4: the F-scores on the
+    /// unseen half of the real frames were flat from 1 to 6 (`docs/bedload.md`); the output
+    /// lags the input by this many frames.
+    pub lag: u32,
+    /// The evidence model.
+    pub emission: EmissionParams,
+}
+
+impl Default for SmootherParams {
+    fn default() -> Self {
+        Self {
+            lag: 4,
+            emission: EmissionParams::default(),
+        }
+    }
+}
+
+/// The most frames a lag may span.
+pub const MAX_LAG: u32 = 1000;
+
+/// Log-likelihoods of one frame's evidence under resting, rolling and saltating; `None` for a
+/// point without evidence (a trajectory's first point).
+pub(crate) type Evidence = Option<[f64; 3]>;
+
+/// The validated smoother, features in px and px/frame.
+#[derive(Debug, Clone)]
+pub(crate) struct Smoother {
+    lag: usize,
+    log_transition: [[f64; 3]; 3],
+    states: [StateEmission; 3],
+    /// px/frame → m/s.
+    m_per_s_per_px_per_frame: f64,
+    speed_floor_m_per_s: f64,
+}
+
+/// The three states in the smoother's order.
+const STATES: [MotionState; 3] = [
+    MotionState::Resting,
+    MotionState::Rolling,
+    MotionState::Saltating,
+];
+
+fn log_sum_exp(values: [f64; 3]) -> f64 {
+    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if max == f64::NEG_INFINITY {
+        return max;
+    }
+    max + values.iter().map(|v| (v - max).exp()).sum::<f64>().ln()
+}
+
+fn argmax(values: [f64; 3]) -> usize {
+    (1..3).fold(0, |best, i| if values[i] > values[best] { i } else { best })
+}
+
+impl SmootherParams {
+    /// The smoother over the transition table `transition` (rows: from resting, rolling,
+    /// saltating), or `None` for a lag of 0; errors name the key.
+    pub(crate) fn smoother(
+        &self,
+        transition: &[[f64; 3]; 3],
+        calibration: &Calibration,
+    ) -> Result<Option<Smoother>> {
+        if self.lag > MAX_LAG {
+            return Err(Error::parameter(
+                "smoother.lag",
+                self.lag,
+                format!(
+                    "must be at most {MAX_LAG} frames (a few frames suffice; 0 turns smoothing off)"
+                ),
+            ));
+        }
+        let e = &self.emission;
+        if !(e.speed_floor_m_per_s.is_finite() && e.speed_floor_m_per_s > 0.0) {
+            return Err(Error::parameter(
+                "smoother.emission.speed_floor_m_per_s",
+                e.speed_floor_m_per_s,
+                "must be a finite number > 0",
+            ));
+        }
+        for (name, state) in [
+            ("resting", &e.resting),
+            ("rolling", &e.rolling),
+            ("saltating", &e.saltating),
+        ] {
+            for (feature, g) in [
+                ("log_speed", &state.log_speed),
+                ("log_contact", &state.log_contact),
+            ] {
+                let key = format!("smoother.emission.{name}.{feature}");
+                if !g.mean.is_finite() {
+                    return Err(Error::parameter(
+                        format!("{key}.mean"),
+                        g.mean,
+                        "must be a finite number",
+                    ));
+                }
+                if !(g.sd.is_finite() && g.sd > 0.0) {
+                    return Err(Error::parameter(
+                        format!("{key}.sd"),
+                        g.sd,
+                        "must be a finite number > 0",
+                    ));
+                }
+            }
+        }
+        for (i, row) in transition.iter().enumerate() {
+            if row.iter().all(|&p| p <= 0.0) {
+                return Err(Error::parameter(
+                    format!("motion.transition[{i}]"),
+                    format!("{row:?}"),
+                    "a row of zeros leaves the state nowhere to go; give each row probabilities \
+                     summing to 1",
+                ));
+            }
+        }
+        if self.lag == 0 {
+            return Ok(None);
+        }
+        Ok(Some(Smoother {
+            lag: self.lag as usize,
+            log_transition: transition.map(|row| row.map(f64::ln)),
+            states: [e.resting, e.rolling, e.saltating],
+            m_per_s_per_px_per_frame: calibration.m_per_px * calibration.fps,
+            speed_floor_m_per_s: e.speed_floor_m_per_s,
+        }))
+    }
+}
+
+/// A point waiting for its state, with its forward message.
+#[derive(Debug, Clone)]
+struct Pending {
+    point: TrackPoint,
+    evidence: Evidence,
+    /// ln p(state, evidence up to this point).
+    log_alpha: [f64; 3],
+}
+
+/// The points of one trajectory whose states are not final yet.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct StateChain {
+    pending: VecDeque<Pending>,
+    /// The forward message of the last point pushed.
+    last_alpha: Option<[f64; 3]>,
+}
+
+impl Smoother {
+    /// The log-likelihoods of a point observed at `speed_px_per_frame` whose nearest bead is
+    /// at `contact_ratio` times the contact distance.
+    pub fn evidence(&self, speed_px_per_frame: f64, contact_ratio: f64) -> [f64; 3] {
+        let speed =
+            (speed_px_per_frame * self.m_per_s_per_px_per_frame + self.speed_floor_m_per_s).ln();
+        let contact = contact_ratio.clamp(1e-3, CONTACT_RATIO_CAP).ln();
+        self.states
+            .map(|s| s.log_speed.log_density(speed) + s.log_contact.log_density(contact))
+    }
+
+    /// Adds the next point of a trajectory; the points whose state became final are appended
+    /// to `out`, in frame order.
+    pub fn push(
+        &self,
+        chain: &mut StateChain,
+        point: TrackPoint,
+        evidence: Evidence,
+        out: &mut Vec<TrackPoint>,
+    ) {
+        let e = evidence.unwrap_or([0.0; 3]);
+        let log_alpha = match chain.last_alpha {
+            None => e.map(|v| v - 3f64.ln()),
+            Some(prev) => std::array::from_fn(|j| {
+                log_sum_exp(std::array::from_fn(|i| prev[i] + self.log_transition[i][j])) + e[j]
+            }),
+        };
+        chain.last_alpha = Some(log_alpha);
+        chain.pending.push_back(Pending {
+            point,
+            evidence,
+            log_alpha,
+        });
+        while chain.pending.len() > self.lag {
+            self.emit_first(chain, out);
+        }
+    }
+
+    /// Decides every pending point of a trajectory that ends (with what follows each).
+    pub fn flush(&self, chain: &mut StateChain, out: &mut Vec<TrackPoint>) {
+        while !chain.pending.is_empty() {
+            self.emit_first(chain, out);
+        }
+        chain.last_alpha = None;
+    }
+
+    /// The first pending point with its smoothed state: forward message × the backward
+    /// message of the points after it.
+    fn emit_first(&self, chain: &mut StateChain, out: &mut Vec<TrackPoint>) {
+        let mut log_beta = [0.0; 3];
+        for later in chain.pending.iter().skip(1).rev() {
+            let e = later.evidence.unwrap_or([0.0; 3]);
+            log_beta = std::array::from_fn(|i| {
+                log_sum_exp(std::array::from_fn(|j| {
+                    self.log_transition[i][j] + e[j] + log_beta[j]
+                }))
+            });
+        }
+        let Some(first) = chain.pending.pop_front() else {
+            return;
+        };
+        let mut point = first.point;
+        if first.evidence.is_some() {
+            let posterior = std::array::from_fn(|i| first.log_alpha[i] + log_beta[i]);
+            point.motion_state = STATES[argmax(posterior)];
+        }
+        out.push(point);
+    }
+}
+
+/// One point for [`fit_emission`]: a tracker's point or a true one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LabelledPoint {
+    /// 0-based frame.
+    pub frame: u64,
+    /// Position, px.
+    pub x: f64,
+    /// Position, px.
+    pub y: f64,
+    /// Bead class (0 black, 1 transparent).
+    pub class: u32,
+    /// Observed speed, px/frame (`None` on a trajectory's first point).
+    pub speed_px_per_frame: Option<f64>,
+    /// Motion state (the truth's; ignored for the tracker's points).
+    pub state: MotionState,
+}
+
+impl LabelledPoint {
+    /// A tracker's (or a truth's) point: its speed is `|vel_px_per_frame|`.
+    pub fn of(point: &TrackPoint) -> Self {
+        Self {
+            frame: point.frame,
+            x: point.pos_px.x,
+            y: point.pos_px.y,
+            class: point.class,
+            speed_px_per_frame: point.vel_px_per_frame.map(|v| v.norm()),
+            state: point.motion_state,
+        }
+    }
+}
+
+/// What [`fit_emission`] learnt from, per state (resting, rolling, saltating).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct EmissionReport {
+    /// Tracker points paired with a true point of a known state, per state.
+    pub samples: [u64; 3],
+    /// Tracker points in the training frames with no true point within a bead radius.
+    pub unpaired: u64,
+}
+
+/// Learns the smoother's evidence model from a tracker's points (`estimates`) and the true
+/// points with states (`truth`) of the same frames, over `frames` (inclusive): each
+/// estimate is paired with the nearest true point of its class and frame within its bead
+/// radius, and each state's Gaussians are the mean and deviation of the paired estimates'
+/// log-features (deviations floored at 0.05). A state with fewer than `min_samples`
+/// samples keeps `base`'s model. Errors when no true point has a known state.
+pub fn fit_emission(
+    estimates: &[LabelledPoint],
+    truth: &[LabelledPoint],
+    frames: [u64; 2],
+    radius_px: &[f64],
+    calibration: &Calibration,
+    base: &EmissionParams,
+    min_samples: u64,
+) -> Result<(EmissionParams, EmissionReport)> {
+    if truth.iter().all(|p| {
+        !matches!(
+            p.state,
+            MotionState::Resting | MotionState::Rolling | MotionState::Saltating
+        )
+    }) {
+        return Err(Error::input(
+            "the ground truth has no motion state (every point unknown, or no `motion_state` \
+             column); the evidence model is learnt from states: give a truth file with states 0 \
+             resting, 1 rolling, 2 saltating",
+        ));
+    }
+    let radius = |class: u32| -> f64 {
+        radius_px
+            .get(class as usize)
+            .or(radius_px.last())
+            .copied()
+            .unwrap_or(0.0)
+    };
+    let in_frames = |p: &&LabelledPoint| (frames[0]..=frames[1]).contains(&p.frame);
+    let mut by_frame: std::collections::BTreeMap<u64, (Vec<LabelledPoint>, Vec<LabelledPoint>)> =
+        Default::default();
+    for p in estimates.iter().filter(in_frames) {
+        by_frame.entry(p.frame).or_default().0.push(*p);
+    }
+    for p in truth.iter().filter(in_frames) {
+        by_frame.entry(p.frame).or_default().1.push(*p);
+    }
+    let floor = base.speed_floor_m_per_s;
+    let scale = calibration.m_per_px * calibration.fps;
+    let mut speeds: [Vec<f64>; 3] = Default::default();
+    let mut contacts: [Vec<f64>; 3] = Default::default();
+    let mut unpaired = 0;
+    for (ests, trues) in by_frame.values() {
+        for e in ests {
+            let Some(speed) = e.speed_px_per_frame else {
+                continue;
+            };
+            let r = radius(e.class);
+            let nearest = trues
+                .iter()
+                .filter(|t| t.class == e.class)
+                .map(|t| ((t.x - e.x).hypot(t.y - e.y), t.state))
+                .filter(|(d, _)| *d <= r)
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let Some((_, state)) = nearest else {
+                unpaired += 1;
+                continue;
+            };
+            let Some(slot) = STATES.iter().position(|&s| s == state) else {
+                continue;
+            };
+            let ratio = ests
+                .iter()
+                .filter(|o| !std::ptr::eq(*o, e))
+                .map(|o| (o.x - e.x).hypot(o.y - e.y) / (r + radius(o.class)))
+                .fold(CONTACT_RATIO_CAP, f64::min);
+            speeds[slot].push((speed * scale + floor).ln());
+            contacts[slot].push(ratio.max(1e-3).ln());
+        }
+    }
+    let mut params = base.clone();
+    let models = [
+        &mut params.resting,
+        &mut params.rolling,
+        &mut params.saltating,
+    ];
+    for ((model, s), c) in models.into_iter().zip(&speeds).zip(&contacts) {
+        if (s.len() as u64) < min_samples.max(2) {
+            continue;
+        }
+        if let (Some(log_speed), Some(log_contact)) =
+            (LogGaussian::fit(s, 0.05), LogGaussian::fit(c, 0.05))
+        {
+            *model = StateEmission {
+                log_speed,
+                log_contact,
+            };
+        }
+    }
+    let report = EmissionReport {
+        samples: std::array::from_fn(|i| speeds[i].len() as u64),
+        unpaired,
+    };
+    Ok((params, report))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const EQ12: [[f64; 3]; 3] = [[0.8, 0.15, 0.05], [0.1, 0.8, 0.1], [0.05, 0.15, 0.8]];
+
+    fn smoother(lag: u32) -> Smoother {
+        SmootherParams {
+            lag,
+            ..SmootherParams::default()
+        }
+        .smoother(&EQ12, &Calibration::new(2.056e-4, 130.0).unwrap())
+        .unwrap()
+        .unwrap()
+    }
+
+    fn point(frame: u64) -> TrackPoint {
+        TrackPoint::at(frame, 1, sillage_core::Point2::new(frame as f64, 0.0))
+    }
+
+    /// Evidence of a bead moving at `speed` px/frame, touching its neighbours.
+    fn run(s: &Smoother, speeds: &[f64]) -> Vec<TrackPoint> {
+        let mut chain = StateChain::default();
+        let mut out = Vec::new();
+        for (frame, &speed) in speeds.iter().enumerate() {
+            s.push(
+                &mut chain,
+                point(frame as u64),
+                Some(s.evidence(speed, 0.95)),
+                &mut out,
+            );
+        }
+        s.flush(&mut chain, &mut out);
+        out
+    }
+
+    #[test]
+    fn a_lag_of_zero_is_no_smoother() {
+        let params = SmootherParams {
+            lag: 0,
+            ..SmootherParams::default()
+        };
+        let calibration = Calibration::new(2.056e-4, 130.0).unwrap();
+        assert!(params.smoother(&EQ12, &calibration).unwrap().is_none());
+    }
+
+    #[test]
+    fn evidence_orders_the_states_by_speed() {
+        let s = smoother(2);
+        let best = |speed: f64| argmax(s.evidence(speed, 0.95));
+        assert_eq!(STATES[best(0.0)], MotionState::Resting);
+        assert_eq!(STATES[best(2.0)], MotionState::Rolling);
+        assert_eq!(STATES[best(14.0)], MotionState::Saltating);
+    }
+
+    #[test]
+    fn points_wait_lag_frames_and_come_out_in_order() {
+        let s = smoother(3);
+        let mut chain = StateChain::default();
+        let mut out = Vec::new();
+        for frame in 0..10 {
+            s.push(
+                &mut chain,
+                point(frame),
+                Some(s.evidence(2.0, 0.95)),
+                &mut out,
+            );
+            assert_eq!(out.len(), (frame as usize + 1).saturating_sub(3));
+        }
+        s.flush(&mut chain, &mut out);
+        let frames: Vec<u64> = out.iter().map(|p| p.frame).collect();
+        assert_eq!(frames, (0..10).collect::<Vec<_>>());
+        // A point without evidence (a trajectory's first) keeps its state.
+        let mut chain = StateChain::default();
+        let mut out = Vec::new();
+        s.push(&mut chain, point(0), None, &mut out);
+        s.flush(&mut chain, &mut out);
+        assert_eq!(out[0].motion_state, MotionState::Unknown);
+    }
+
+    #[test]
+    fn one_still_frame_inside_a_roll_stays_rolling() {
+        // A bead rolling at 2 px/frame that seems to stop for one frame: frame by frame
+        // that frame is resting; over the trajectory it is rolling.
+        let speeds = [2.0, 2.5, 1.8, 0.0, 2.2, 1.9, 2.4];
+        let frame_by_frame = STATES[argmax(smoother(1).evidence(0.0, 0.95))];
+        assert_eq!(frame_by_frame, MotionState::Resting);
+        let out = run(&smoother(2), &speeds);
+        assert!(
+            out.iter().all(|p| p.motion_state == MotionState::Rolling),
+            "{out:?}"
+        );
+        // A real stop (several frames) is kept.
+        let out = run(&smoother(2), &[2.0, 2.0, 2.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let states: Vec<_> = out.iter().map(|p| p.motion_state).collect();
+        assert_eq!(states[1], MotionState::Rolling);
+        assert_eq!(states[6], MotionState::Resting);
+    }
+
+    fn labelled(frame: u64, x: f64, speed: f64, state: MotionState) -> LabelledPoint {
+        LabelledPoint {
+            frame,
+            x,
+            y: 0.0,
+            class: 0,
+            speed_px_per_frame: Some(speed),
+            state,
+        }
+    }
+
+    #[test]
+    fn fit_learns_each_state_from_the_paired_points_of_the_training_frames() {
+        // Two beads 60 px apart (contact ratio 2, the cap): one resting at 0.1 px/frame,
+        // one rolling at 2 or 4 px/frame; frames 5.. are outside the training range and
+        // would spoil the rolling model.
+        let mut estimates = Vec::new();
+        let mut truth = Vec::new();
+        for frame in 0..10 {
+            let roll_speed = if frame < 5 {
+                2.0 + 2.0 * (frame % 2) as f64
+            } else {
+                50.0
+            };
+            estimates.push(labelled(frame, 0.0, 0.1, MotionState::Unknown));
+            estimates.push(labelled(frame, 60.0, roll_speed, MotionState::Unknown));
+            truth.push(labelled(frame, 0.5, 0.0, MotionState::Resting));
+            truth.push(labelled(frame, 60.5, 0.0, MotionState::Rolling));
+        }
+        let calibration = Calibration::new(2.056e-4, 130.0).unwrap();
+        let base = EmissionParams::default();
+        let (fitted, report) =
+            fit_emission(&estimates, &truth, [0, 4], &[15.0], &calibration, &base, 2).unwrap();
+        assert_eq!(report.samples, [5, 5, 0]);
+        let scale = 2.056e-4 * 130.0;
+        let floor = base.speed_floor_m_per_s;
+        let rest = (0.1 * scale + floor).ln();
+        assert!((fitted.resting.log_speed.mean - rest).abs() < 1e-12);
+        assert_eq!(fitted.resting.log_speed.sd, 0.05);
+        let (a, b) = ((2.0 * scale + floor).ln(), (4.0 * scale + floor).ln());
+        let mean = (3.0 * a + 2.0 * b) / 5.0;
+        assert!((fitted.rolling.log_speed.mean - mean).abs() < 1e-12);
+        assert!((fitted.rolling.log_contact.mean - 2f64.ln()).abs() < 1e-12);
+        // Too few saltating samples: the base model is kept.
+        assert_eq!(fitted.saltating, base.saltating);
+    }
+
+    #[test]
+    fn a_truth_without_states_is_refused() {
+        let points = [labelled(0, 0.0, 1.0, MotionState::Unknown)];
+        let calibration = Calibration::new(2.056e-4, 130.0).unwrap();
+        let e = fit_emission(
+            &points,
+            &points,
+            [0, 0],
+            &[15.0],
+            &calibration,
+            &EmissionParams::default(),
+            1,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("no motion state"), "{e}");
+    }
+}
