@@ -79,8 +79,28 @@ impl Contacts {
     }
 
     /// The centre distance from a bead of class `class` at `p` to the nearest indexed bead
-    /// (not `exclude`) over the sum of their radii (1 = touching), capped at `cap`.
+    /// (not `exclude`) over the sum of their radii (1 = touching), capped at `cap`. Searched
+    /// near first (most beads touch one), then out to the cap.
     pub fn nearest_ratio(
+        &self,
+        p: Point2,
+        class: ObjectClass,
+        exclude: Option<usize>,
+        radii: &[f64],
+        cap: f64,
+    ) -> f64 {
+        const NEAR: f64 = 1.25;
+        let near = self.nearest_ratio_within(p, class, exclude, radii, cap.min(NEAR));
+        if near < NEAR || cap <= NEAR {
+            near
+        } else {
+            self.nearest_ratio_within(p, class, exclude, radii, cap)
+        }
+    }
+
+    /// [`Contacts::nearest_ratio`] among the beads within `cap` times the largest contact
+    /// distance.
+    fn nearest_ratio_within(
         &self,
         p: Point2,
         class: ObjectClass,

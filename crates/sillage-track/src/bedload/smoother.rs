@@ -135,7 +135,7 @@ pub(crate) type Evidence = Option<[f64; 3]>;
 #[derive(Debug, Clone)]
 pub(crate) struct Smoother {
     lag: usize,
-    log_transition: [[f64; 3]; 3],
+    transition: [[f64; 3]; 3],
     states: [StateEmission; 3],
     /// px/frame → m/s.
     m_per_s_per_px_per_frame: f64,
@@ -149,12 +149,17 @@ const STATES: [MotionState; 3] = [
     MotionState::Saltating,
 ];
 
-fn log_sum_exp(values: [f64; 3]) -> f64 {
-    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if max == f64::NEG_INFINITY {
-        return max;
-    }
-    max + values.iter().map(|v| (v - max).exp()).sum::<f64>().ln()
+/// `v` scaled to sum to 1 (left as it is when it sums to 0).
+fn normalised(v: [f64; 3]) -> [f64; 3] {
+    let sum: f64 = v.iter().sum();
+    if sum > 0.0 { v.map(|x| x / sum) } else { v }
+}
+
+/// The likelihoods of log-likelihoods `e`, scaled so that the largest is 1 (the scale
+/// cancels in the smoother's normalised messages).
+fn likelihoods(e: [f64; 3]) -> [f64; 3] {
+    let max = e.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    e.map(|v| (v - max).exp())
 }
 
 fn argmax(values: [f64; 3]) -> usize {
@@ -227,7 +232,7 @@ impl SmootherParams {
         }
         Ok(Some(Smoother {
             lag: self.lag as usize,
-            log_transition: transition.map(|row| row.map(f64::ln)),
+            transition: *transition,
             states: [e.resting, e.rolling, e.saltating],
             m_per_s_per_px_per_frame: calibration.m_per_px * calibration.fps,
             speed_floor_m_per_s: e.speed_floor_m_per_s,
@@ -239,9 +244,10 @@ impl SmootherParams {
 #[derive(Debug, Clone)]
 struct Pending {
     point: TrackPoint,
-    evidence: Evidence,
-    /// ln p(state, evidence up to this point).
-    log_alpha: [f64; 3],
+    /// The evidence as likelihoods scaled to a largest of 1; `None` for no evidence.
+    likelihood: Option<[f64; 3]>,
+    /// p(state | evidence up to this point), normalised.
+    alpha: [f64; 3],
 }
 
 /// The points of one trajectory whose states are not final yet.
@@ -264,7 +270,8 @@ impl Smoother {
     }
 
     /// Adds the next point of a trajectory; the points whose state became final are appended
-    /// to `out`, in frame order.
+    /// to `out`, in frame order. The messages are normalised probabilities (no logarithm
+    /// in the recursion).
     pub fn push(
         &self,
         chain: &mut StateChain,
@@ -272,18 +279,19 @@ impl Smoother {
         evidence: Evidence,
         out: &mut Vec<TrackPoint>,
     ) {
-        let e = evidence.unwrap_or([0.0; 3]);
-        let log_alpha = match chain.last_alpha {
-            None => e.map(|v| v - 3f64.ln()),
-            Some(prev) => std::array::from_fn(|j| {
-                log_sum_exp(std::array::from_fn(|i| prev[i] + self.log_transition[i][j])) + e[j]
-            }),
+        let likelihood = evidence.map(likelihoods);
+        let e = likelihood.unwrap_or([1.0; 3]);
+        let alpha = match chain.last_alpha {
+            None => normalised(e),
+            Some(prev) => normalised(std::array::from_fn(|j| {
+                (0..3).map(|i| prev[i] * self.transition[i][j]).sum::<f64>() * e[j]
+            })),
         };
-        chain.last_alpha = Some(log_alpha);
+        chain.last_alpha = Some(alpha);
         chain.pending.push_back(Pending {
             point,
-            evidence,
-            log_alpha,
+            likelihood,
+            alpha,
         });
         while chain.pending.len() > self.lag {
             self.emit_first(chain, out);
@@ -301,21 +309,21 @@ impl Smoother {
     /// The first pending point with its smoothed state: forward message × the backward
     /// message of the points after it.
     fn emit_first(&self, chain: &mut StateChain, out: &mut Vec<TrackPoint>) {
-        let mut log_beta = [0.0; 3];
+        let mut beta = [1.0; 3];
         for later in chain.pending.iter().skip(1).rev() {
-            let e = later.evidence.unwrap_or([0.0; 3]);
-            log_beta = std::array::from_fn(|i| {
-                log_sum_exp(std::array::from_fn(|j| {
-                    self.log_transition[i][j] + e[j] + log_beta[j]
-                }))
-            });
+            let e = later.likelihood.unwrap_or([1.0; 3]);
+            beta = normalised(std::array::from_fn(|i| {
+                (0..3)
+                    .map(|j| self.transition[i][j] * e[j] * beta[j])
+                    .sum::<f64>()
+            }));
         }
         let Some(first) = chain.pending.pop_front() else {
             return;
         };
         let mut point = first.point;
-        if first.evidence.is_some() {
-            let posterior = std::array::from_fn(|i| first.log_alpha[i] + log_beta[i]);
+        if first.likelihood.is_some() {
+            let posterior = std::array::from_fn(|i| first.alpha[i] * beta[i]);
             point.motion_state = STATES[argmax(posterior)];
         }
         out.push(point);
