@@ -10,10 +10,10 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
-use sillage::bedload::fit::{config_text, fit_smoother, read_state_tracks, tracks_without_state};
+use sillage::bedload::fit::fit_bedload_files;
 use sillage::filter::fit::STATE_NAMES;
-use sillage::filter::{BedloadFit, BedloadParams, FitOptions, FitReport, fit_bedload};
-use sillage::track::bedload::{BedloadTrackerParams, EmissionParams, EmissionReport};
+use sillage::filter::{BedloadFit, BedloadParams, FitOptions, FitReport};
+use sillage::track::bedload::{EmissionParams, EmissionReport};
 
 use crate::shared_args::JsonArg;
 
@@ -74,62 +74,38 @@ pub fn run_bedload(args: &FitBedloadArgs) -> Result<()> {
     options
         .validate()
         .context("invalid option (--train-fraction, --min-probability, --min-samples)")?;
-    let tracks = read_state_tracks(&args.truth).context(
-        "cannot read the ground truth given by --truth (a BeadTracking CSV: \
-         frame,id,x,y,category,vx,vy,motion_state)",
-    )?;
-    let tracks_without_state = tracks_without_state(&tracks);
-    let fit = fit_bedload(&tracks, &BedloadParams::default(), &options).with_context(|| {
-        format!(
-            "cannot fit the bedload motion parameters to {}",
-            args.truth.display()
-        )
-    })?;
-    let emission = match &args.tracks {
-        Some(path) => {
-            let (model, report) = fit_smoother(
-                &args.truth,
-                path,
-                fit.report.training_frames,
-                &BedloadTrackerParams::default(),
-                args.min_samples,
+    let fitted =
+        fit_bedload_files(&args.truth, args.tracks.as_deref(), &options).with_context(|| {
+            format!(
+                "cannot fit the bedload parameters to --truth {} (a BeadTracking CSV: \
+                 frame,id,x,y,category,vx,vy,motion_state){}",
+                args.truth.display(),
+                args.tracks
+                    .as_ref()
+                    .map(|t| format!(" and --tracks {}", t.display()))
+                    .unwrap_or_default()
             )
-            .with_context(|| {
-                format!(
-                    "cannot learn the motion-state evidence from {} (--tracks)",
-                    path.display()
-                )
-            })?;
-            Some((path.as_path(), model, report))
-        }
-        None => None,
-    };
-    let text = config_text(
-        &args.truth,
-        &options,
-        &fit,
-        tracks.len(),
-        tracks_without_state,
-        emission.as_ref().map(|(p, m, r)| (*p, m, r)),
-    )?;
-    write_config(&args.out, &text)?;
+        })?;
+    let (fit, text) = (&fitted.fit, &fitted.text);
+    let emission = args.tracks.as_deref().zip(fitted.emission.as_ref());
+    write_config(&args.out, text)?;
     if args.json.enabled {
         let summary = JsonSummary {
             truth: &args.truth,
             out: &args.out,
-            tracks: tracks.len(),
-            tracks_without_state,
+            tracks: fitted.tracks,
+            tracks_without_state: fitted.tracks_without_state,
             train_fraction: options.train_fraction,
             min_probability: options.min_probability,
             min_samples: options.min_samples,
             motion: &fit.params,
             report: &fit.report,
-            emission: emission.as_ref().map(|(_, m, r)| (m, r)),
+            emission: fitted.emission.as_ref().map(|(m, r)| (m, r)),
         };
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        print!("{}", human_summary(args, &fit, tracks.len()));
-        if let Some((path, model, report)) = &emission {
+        print!("{}", human_summary(args, fit, fitted.tracks));
+        if let Some((path, (model, report))) = emission {
             print!("{}", emission_summary(path, model, report));
         }
     }

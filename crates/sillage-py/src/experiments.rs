@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use serde::Serialize;
-use sillage::bedload::fit::{config_text, read_state_tracks, tracks_without_state};
+use sillage::bedload::fit::fit_bedload_files;
 use sillage::core::{Error, Result};
 use sillage::experiments::immpf::BenchInput;
 use sillage::experiments::{immpf, siftpf};
-use sillage::filter::{BedloadParams, FitOptions, MotionPriorParams, fit_bedload};
+use sillage::filter::{BedloadParams, FitOptions, MotionPriorParams};
 use sillage::io::write_text;
 use sillage::pedestrian::homography::{HomographySource, fit_homography};
 use sillage::pedestrian::immpf::Scene;
@@ -31,45 +31,55 @@ fn json(value: &impl Serialize) -> Result<String> {
 
 /// Fits `kind` (`bedload`, `homography`, `motion-prior`) to the ground truth `truth`, writes
 /// the result to `out` when given (the file the command line writes), and returns what was
-/// fitted as JSON.
+/// fitted as JSON. `tracks` (bedload only): a tracker's output on the truth's frames, from
+/// which the motion-state smoother's evidence is learnt.
 #[pyfunction]
-#[pyo3(signature = (kind, truth, out=None))]
-pub fn fit(py: Python<'_>, kind: &str, truth: PathBuf, out: Option<PathBuf>) -> PyResult<String> {
-    let run = match kind {
-        "bedload" => fit_bedload_file,
-        "homography" => fit_homography_file,
-        "motion-prior" => fit_motion_prior_file,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "unknown fit `{other}`; choose bedload, homography or motion-prior"
-            )));
-        }
-    };
-    py.detach(|| run(&truth, out.as_deref())).map_err(to_py)
+#[pyo3(signature = (kind, truth, out=None, tracks=None))]
+pub fn fit(
+    py: Python<'_>,
+    kind: &str,
+    truth: PathBuf,
+    out: Option<PathBuf>,
+    tracks: Option<PathBuf>,
+) -> PyResult<String> {
+    if tracks.is_some() && kind != "bedload" {
+        return Err(PyValueError::new_err(format!(
+            "`tracks` is for fit(\"bedload\", ...) only, not `{kind}`"
+        )));
+    }
+    py.detach(|| match kind {
+        "bedload" => fit_bedload_file(&truth, tracks.as_deref(), out.as_deref()),
+        "homography" => fit_homography_file(&truth, out.as_deref()),
+        "motion-prior" => fit_motion_prior_file(&truth, out.as_deref()),
+        other => Err(Error::input(format!(
+            "unknown fit `{other}`; choose bedload, homography or motion-prior"
+        ))),
+    })
+    .map_err(to_py)
 }
 
-/// The MMPF+ motion parameters of a BeadTracking truth with motion states.
-fn fit_bedload_file(truth: &Path, out: Option<&Path>) -> Result<String> {
-    let options = FitOptions::default();
-    let tracks = read_state_tracks(truth)?;
-    let without = tracks_without_state(&tracks);
-    let fit = fit_bedload(&tracks, &BedloadParams::default(), &options)?;
-    let text = config_text(truth, &options, &fit, tracks.len(), without, None)?;
+/// The MMPF+ motion parameters of a BeadTracking truth with motion states, and the smoother's
+/// evidence with `tracks`.
+fn fit_bedload_file(truth: &Path, tracks: Option<&Path>, out: Option<&Path>) -> Result<String> {
+    let fitted = fit_bedload_files(truth, tracks, &FitOptions::default())?;
     if let Some(path) = out {
-        write_text(path, &text)?;
+        write_text(path, &fitted.text)?;
     }
     #[derive(Serialize)]
     struct Fitted<'a> {
         tracks: usize,
         tracks_without_state: usize,
         motion: &'a BedloadParams,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        emission: Option<&'a sillage::track::bedload::EmissionParams>,
         config: &'a str,
     }
     json(&Fitted {
-        tracks: tracks.len(),
-        tracks_without_state: without,
-        motion: &fit.params,
-        config: &text,
+        tracks: fitted.tracks,
+        tracks_without_state: fitted.tracks_without_state,
+        motion: &fitted.fit.params,
+        emission: fitted.emission.as_ref().map(|(e, _)| e),
+        config: &fitted.text,
     })
 }
 

@@ -492,6 +492,15 @@ def test_fit_learns_what_the_command_line_learns_and_track_takes_it(tmp_path):
     assert prior["tracks"] > 5 and prior["width_px"] == 768
     motion = sillage.fit("bedload", BEADS / "ground_truth" / "trackdatatruth.csv")
     assert motion["tracks"] > 10 and "[motion" in motion["config"]
+    assert "emission" not in motion
+    # The smoother's evidence from a tracker's output (the truth's own speeds stand in).
+    truth = BEADS / "ground_truth" / "trackdatatruth.csv"
+    smoothed = sillage.fit("bedload", truth, tracks=truth, out=tmp_path / "bedload.toml")
+    emission = smoothed["emission"]
+    assert emission["resting"]["log_speed"]["mean"] < emission["saltating"]["log_speed"]["mean"]
+    assert "[smoother.emission" in (tmp_path / "bedload.toml").read_text()
+    with pytest.raises(ValueError, match="bedload"):
+        sillage.fit("homography", PETS.parent / "gt" / "gt.txt", tracks=truth)
     with pytest.raises(ValueError, match="unknown fit"):
         sillage.fit("kalman", PETS)
 

@@ -419,7 +419,8 @@ def evaluate(truth: pd.DataFrame, tracks: pd.DataFrame, *, match: str | None = N
     return scores
 
 
-def fit(kind: str, truth: str | Any, *, out: str | Any | None = None) -> dict:
+def fit(kind: str, truth: str | Any, *, out: str | Any | None = None,
+        tracks: str | Any | None = None) -> dict:
     """Learns model parameters from ground truth, as ``sillage fit KIND`` does.
 
     ``kind`` is ``"bedload"`` (the MMPF+ motion parameters and transition table from a
@@ -428,11 +429,15 @@ def fit(kind: str, truth: str | Any, *, out: str | Any | None = None) -> dict:
     ``"motion-prior"`` (the IMM-PF's learned motion prior, 30-px cells, from a MOTChallenge
     ``gt.txt``). ``out`` writes the file the command line writes (a bedload TOML
     configuration, a ground-plane TOML, a prior JSON), which :func:`track` then takes
-    (``params``, ``ground_plane=``, ``motion_prior=``). Returns what was fitted as a dict.
+    (``params``, ``ground_plane=``, ``motion_prior=``). ``tracks`` (bedload only): the output
+    of ``sillage track bedload`` on the truth's frames (BeadTracking CSV); the motion-state
+    smoother's evidence is then learnt too (``emission``, ``[smoother.emission]``). Returns
+    what was fitted as a dict.
 
     >>> sillage.fit("homography", "PETS09-S2L1/gt/gt.txt", out="ground.toml")["boxes"]
     """
-    return json.loads(_sillage.fit(kind, _path(truth), _optional_path(out)))
+    return json.loads(_sillage.fit(kind, _path(truth), _optional_path(out),
+                                   _optional_path(tracks)))
 
 
 def bench(kind: str, sequences: Iterable[str | Any], *, runs: int = 1,

@@ -10,7 +10,7 @@ use std::path::Path;
 use serde::Serialize;
 use sillage_core::{Error, MotionState, Result, Vec2};
 use sillage_filter::fit::STATE_NAMES;
-use sillage_filter::{BedloadFit, BedloadParams, FitOptions, StatePoint, StateTrack};
+use sillage_filter::{BedloadFit, BedloadParams, FitOptions, StatePoint, StateTrack, fit_bedload};
 use sillage_io::read_bead_csv;
 use sillage_track::bedload::{
     BedloadTrackerParams, EmissionParams, EmissionReport, LabelledPoint, fit_emission,
@@ -108,9 +108,65 @@ pub fn tracks_without_state(tracks: &[StateTrack]) -> usize {
         .count()
 }
 
+/// Everything `sillage fit bedload` learns from its files, and the config text recording it.
+#[derive(Debug, Clone)]
+pub struct BedloadFitFile {
+    /// The motion parameters (`[motion]`) and their report.
+    pub fit: BedloadFit,
+    /// The smoother's evidence model (`[smoother.emission]`) and its samples, when a tracker's
+    /// output was given.
+    pub emission: Option<(EmissionParams, EmissionReport)>,
+    /// Trajectories in the truth.
+    pub tracks: usize,
+    /// Trajectories without any motion state.
+    pub tracks_without_state: usize,
+    /// The TOML text to write.
+    pub text: String,
+}
+
+/// Learns the motion parameters from `truth` (a BeadTracking CSV with states) and, with
+/// `tracks` (`sillage track bedload`'s output on the same frames), the smoother's evidence
+/// model on the same training frames; errors name the file.
+pub fn fit_bedload_files(
+    truth: &Path,
+    tracks: Option<&Path>,
+    options: &FitOptions,
+) -> Result<BedloadFitFile> {
+    let truth_tracks = read_state_tracks(truth)?;
+    let without = tracks_without_state(&truth_tracks);
+    let fit = fit_bedload(&truth_tracks, &BedloadParams::default(), options)
+        .map_err(|e| Error::input(format!("{}: {e}", truth.display())))?;
+    let emission = tracks
+        .map(|path| {
+            fit_smoother(
+                truth,
+                path,
+                fit.report.training_frames,
+                &BedloadTrackerParams::default(),
+                options.min_samples,
+            )
+        })
+        .transpose()?;
+    let text = config_text(
+        truth,
+        options,
+        &fit,
+        truth_tracks.len(),
+        without,
+        tracks.zip(emission.as_ref()).map(|(p, (m, r))| (p, m, r)),
+    )?;
+    Ok(BedloadFitFile {
+        fit,
+        emission,
+        tracks: truth_tracks.len(),
+        tracks_without_state: without,
+        text,
+    })
+}
+
 /// The TOML file of `fit`: comment lines saying where the values come from (the `truth`
 /// file, its `tracks`, the fit `options`), then `[motion]`.
-pub fn config_text(
+fn config_text(
     truth: &Path,
     options: &FitOptions,
     fit: &BedloadFit,
