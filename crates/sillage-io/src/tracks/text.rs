@@ -12,7 +12,7 @@ use super::columns::{
     point_from_values,
 };
 use super::{TrackFileHeader, TrackWriter, WrittenSummary};
-use crate::text_table::{CsvTable, RowWriter, parse_index, push_opt};
+use crate::text_table::{CsvTable, RowWriter, parse_index, push_fixed, push_opt};
 
 /// The column line of TracTrac's `_track.txt` (its third header line, after `#  `).
 pub const TRACTRAC_COLUMNS_LINE: &str =
@@ -58,7 +58,8 @@ impl TextStyle {
                 for (value, decimals) in all.zip(TRACTRAC_DECIMALS) {
                     match value {
                         Some(v) => {
-                            let _ = write!(out, " {v:.decimals$}");
+                            out.push(' ');
+                            push_fixed(out, v, decimals);
                         }
                         None => out.push_str(" nan"),
                     }
