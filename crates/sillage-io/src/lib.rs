@@ -98,9 +98,9 @@ pub use numeric_table::{ColumnValues, NumericFormat, NumericTable, write_numeric
 pub use partial::PartialFile;
 pub use table_format::{TableFormat, detect_table_format};
 pub use tracks::{
-    STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE, TrackFileHeader, TrackFormat, TrackLayout,
-    TrackTable, TrackWriter, WrittenSummary, create_track_writer, for_each_track_point,
-    read_track_table, read_tracks,
+    BackgroundWriter, QUEUED_BATCHES, STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE,
+    TrackFileHeader, TrackFormat, TrackLayout, TrackTable, TrackWriter, WrittenSummary,
+    create_track_writer, for_each_track_point, read_track_table, read_tracks, write_in_background,
 };
 pub use tractrac_par::{
     TRACTRAC_KEYS, TractracPar, parse_tractrac_par, read_tractrac_par, write_tractrac_par,

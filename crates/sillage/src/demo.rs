@@ -13,7 +13,7 @@ use crate::ptv_run::PtvRun;
 
 /// Sends every batch to several sinks (the writers and an in-memory copy for scoring).
 struct FanOut<'a> {
-    writers: Vec<Box<dyn TrackWriter>>,
+    writers: Vec<Box<dyn TrackWriter + Send>>,
     collected: &'a mut Vec<TrackPoint>,
 }
 

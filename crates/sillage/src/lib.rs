@@ -44,6 +44,7 @@ pub mod plots;
 pub mod process_memory;
 pub mod ptv_accuracy_bench;
 pub mod ptv_bench;
+pub mod ptv_files_bench;
 pub mod ptv_run;
 pub mod tables;
 pub mod toml_config;

@@ -6,8 +6,8 @@ use std::path::Path;
 
 use sillage_core::{Error, Result, TrackSink};
 use sillage_io::{
-    FrameOptions, FrameSource, TrackFileHeader, TrackFormat, WrittenSummary, create_track_writer,
-    open_frames, read_tractrac_par,
+    FrameOptions, FrameSource, TrackFileHeader, TrackFormat, TrackWriter, WrittenSummary,
+    create_track_writer, open_frames, read_tractrac_par, write_in_background,
 };
 
 use sillage_detect::blob::Calibration;
@@ -157,7 +157,12 @@ impl PtvRun {
         format: TrackFormat,
         on_frame: &mut dyn FnMut(&FrameReport),
     ) -> Result<PtvFileRun> {
-        let mut writer = create_track_writer(out, format, &self.header)?;
+        // Rows are formatted and written on a thread of their own while tracking goes on.
+        let mut writer = Box::new(write_in_background(create_track_writer(
+            out,
+            format,
+            &self.header,
+        )?)?);
         let outcome = self.run(writer.as_mut(), on_frame);
         let written = writer.finish()?;
         Ok(PtvFileRun {

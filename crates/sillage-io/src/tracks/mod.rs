@@ -2,6 +2,7 @@
 //! `_track.txt`, CSV, Parquet (feature `parquet`) and HDF5 (feature `hdf5`).
 
 #[cfg(any(feature = "parquet", feature = "hdf5"))]
+mod background;
 mod column_buffer;
 mod columns;
 #[cfg(feature = "hdf5")]
@@ -16,6 +17,7 @@ use std::str::FromStr;
 
 use sillage_core::{Error, Result, TrackPoint, TrackSink};
 
+pub use background::{BackgroundWriter, QUEUED_BATCHES, write_in_background};
 pub use columns::{STATE_COLUMNS, TRACK_COLUMNS, TrackLayout};
 pub use text::TRACTRAC_COLUMNS_LINE;
 
@@ -147,7 +149,7 @@ pub fn create_track_writer(
     path: &Path,
     format: TrackFormat,
     header: &TrackFileHeader,
-) -> Result<Box<dyn TrackWriter>> {
+) -> Result<Box<dyn TrackWriter + Send>> {
     match format {
         TrackFormat::Tractrac if header.layout == TrackLayout::WithStates => {
             Err(Error::input(format!(
