@@ -148,14 +148,34 @@ fn decode_failure(message: &str) -> String {
     format!("cannot decode: {message}; remove or replace the file")
 }
 
+/// Files decoded at once by the reading thread's helpers: a compressed TIFF decodes on one
+/// core, so a few frames decode side by side; they are emitted in order.
+const PARALLEL_DECODES: usize = 2;
+
 fn read_files(files: &[PathBuf], colour: bool, emitter: &mut Emitter) {
-    for path in files {
-        let keep_going = match decode::decode_file(path, colour) {
-            Ok(image) => emitter.frame(path, image),
-            Err(message) => emitter.fail(path, decode_failure(&message)),
-        };
-        if !keep_going {
-            return;
+    for group in files.chunks(PARALLEL_DECODES) {
+        let decoded: Vec<_> = std::thread::scope(|scope| {
+            let helpers: Vec<_> = group[1..]
+                .iter()
+                .map(|path| scope.spawn(move || decode::decode_file(path, colour)))
+                .collect();
+            let first = decode::decode_file(&group[0], colour);
+            std::iter::once(first)
+                .chain(helpers.into_iter().map(|helper| {
+                    helper
+                        .join()
+                        .unwrap_or_else(|_| Err("the decoder stopped unexpectedly".to_string()))
+                }))
+                .collect()
+        });
+        for (path, result) in group.iter().zip(decoded) {
+            let keep_going = match result {
+                Ok(image) => emitter.frame(path, image),
+                Err(message) => emitter.fail(path, decode_failure(&message)),
+            };
+            if !keep_going {
+                return;
+            }
         }
     }
 }
