@@ -25,6 +25,7 @@ use crate::synth::VortexArgs;
 use crate::synth_bedload::SynthBedloadArgs;
 use crate::synth_walkers::SynthWalkersArgs;
 use crate::track::TrackBedloadArgs;
+use crate::track_boxes::TrackBoxesArgs;
 use crate::track_immpf::TrackImmpfArgs;
 use crate::track_siftpf::TrackSiftpfArgs;
 use crate::tune::TuneArgs;
@@ -191,6 +192,10 @@ pub enum TrackCommand {
     /// filter, objects linked through the features they share, with merges, splits and
     /// occlusions (Souded et al. 2011); writes MOTChallenge results.
     Siftpf(TrackSiftpfArgs),
+    /// Boxes on detections alone with SORT (Bewley et al. 2016: Kalman filter per box,
+    /// Hungarian algorithm on IoU), the baseline of the pedestrian trackers; writes
+    /// MOTChallenge results.
+    Boxes(TrackBoxesArgs),
 }
 
 /// `sillage detect <kind>`.

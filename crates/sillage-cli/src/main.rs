@@ -28,6 +28,7 @@ mod synth;
 mod synth_bedload;
 mod synth_walkers;
 mod track;
+mod track_boxes;
 mod track_immpf;
 mod track_input;
 mod track_siftpf;
@@ -62,6 +63,7 @@ fn main() {
         cli::Command::Track(cli::TrackCommand::Bedload(a)) => track::run_bedload(&a),
         cli::Command::Track(cli::TrackCommand::Immpf(a)) => track_immpf::run(&a),
         cli::Command::Track(cli::TrackCommand::Siftpf(a)) => track_siftpf::run(&a),
+        cli::Command::Track(cli::TrackCommand::Boxes(a)) => track_boxes::run(&a),
         cli::Command::Detect(cli::DetectCommand::Bead(a)) => detect::run_bead(&a),
         cli::Command::Detect(cli::DetectCommand::Motion(a)) => detect_motion::run_motion(&a),
         cli::Command::Eulerian(a) => eulerian::run(&a),

@@ -7,6 +7,7 @@
 //!   Kalman IMM and deterministic baselines of its Table 1 (Lafaye de Micheaux et al. 2018).
 //! - [`immpf`]: pedestrians, one IMM particle filter per person with competing motion models
 //!   (Madrigal & Hayet).
+//! - [`sort`]: SORT (Bewley et al. 2016), the box-tracking baseline on detections.
 //!
 //! ```
 //! use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker};
@@ -34,3 +35,4 @@ pub mod bedload;
 pub mod immpf;
 pub mod ptv;
 pub mod siftpf;
+pub mod sort;

@@ -15,6 +15,7 @@ pub mod motion;
 pub mod motion_prior;
 pub mod settings;
 pub mod siftpf;
+pub mod sort;
 pub mod walkers;
 
 pub use ground_plane::{FitTable, GroundPlaneFile};
