@@ -72,8 +72,9 @@ fn bench_into(
     }
     let decode_ms = ms_per_frame(start.elapsed().as_secs_f64(), decoded);
     let mut points: Vec<TrackPoint> = Vec::new();
-    let header = PtvRun::open(config, input)?.header().clone();
-    PtvRun::open(config, input)?.run(&mut points, &mut |_| {})?;
+    let collect = PtvRun::open(config, input)?;
+    let header = collect.header().clone();
+    collect.run(&mut points, &mut |_| {})?;
     let mut rows = Vec::new();
     for &format in formats {
         let out = out_dir.join(format!("bench_tracks.{}", format.extension()));

@@ -66,7 +66,7 @@ pub fn fit_smoother(
 
 /// Reads a BeadTracking CSV and groups its points by bead id, frames increasing; an id given
 /// twice in one frame is an error naming the file.
-pub fn read_state_tracks(path: &Path) -> Result<Vec<StateTrack>> {
+fn read_state_tracks(path: &Path) -> Result<Vec<StateTrack>> {
     let points = read_bead_csv(path)?;
     let mut by_id: BTreeMap<u64, Vec<StatePoint>> = BTreeMap::new();
     for p in points {
@@ -97,7 +97,7 @@ pub fn read_state_tracks(path: &Path) -> Result<Vec<StateTrack>> {
 }
 
 /// How many of `tracks` carry no motion state at all (they add no transition).
-pub fn tracks_without_state(tracks: &[StateTrack]) -> usize {
+fn tracks_without_state(tracks: &[StateTrack]) -> usize {
     tracks
         .iter()
         .filter(|t| {
