@@ -1,5 +1,6 @@
-//! `sillage track boxes`: SORT (Bewley et al. 2016) on a MOTChallenge detection file, the
-//! baseline the pedestrian trackers are compared with; writes MOTChallenge results.
+//! `sillage track boxes`: SORT (Bewley et al. 2016) or ByteTrack (Zhang et al. 2022) on a
+//! MOTChallenge detection file, the baselines the pedestrian trackers are compared with;
+//! writes MOTChallenge results.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -8,7 +9,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
 use sillage::io::write_mot_results;
-use sillage::pedestrian::sort::track_boxes_with_sort;
+use sillage::pedestrian::boxes::{BoxTracker, track_boxes};
+use sillage::track::bytetrack::ByteTrackParams;
 use sillage::track::sort::SortParams;
 
 use crate::shared_args::JsonArg;
@@ -22,13 +24,18 @@ pub struct TrackBoxesArgs {
     /// MOTChallenge results to write (1-based frames).
     #[arg(long, short, value_name = "FILE")]
     pub out: PathBuf,
-    /// Frames a track may go unmatched before it ends.
+    /// `sort` (the filters' boxes written) or `bytetrack` (as `supervision` 0.30.9: the
+    /// detections matched to tracks written; its defaults: activation 0.25, lost buffer 30
+    /// frames, matching 0.8).
+    #[arg(long, default_value = "sort", value_parser = ["sort", "bytetrack"])]
+    pub tracker: String,
+    /// SORT: frames a track may go unmatched before it ends.
     #[arg(long, default_value_t = SortParams::default().max_age)]
     pub max_age: u32,
-    /// Consecutive matches before a track is written.
+    /// SORT: consecutive matches before a track is written.
     #[arg(long, default_value_t = SortParams::default().min_hits)]
     pub min_hits: u32,
-    /// Smallest IoU of a match.
+    /// SORT: smallest IoU of a match.
     #[arg(long, default_value_t = SortParams::default().iou_threshold)]
     pub iou_threshold: f64,
     /// Drop detections scoring below this.
@@ -51,13 +58,16 @@ struct Summary {
 
 /// `sillage track boxes --detections det.txt --out FILE`.
 pub fn run(args: &TrackBoxesArgs) -> Result<()> {
-    let params = SortParams {
-        max_age: args.max_age,
-        min_hits: args.min_hits,
-        iou_threshold: args.iou_threshold,
+    let tracker = match args.tracker.as_str() {
+        "bytetrack" => BoxTracker::ByteTrack(ByteTrackParams::default()),
+        _ => BoxTracker::Sort(SortParams {
+            max_age: args.max_age,
+            min_hits: args.min_hits,
+            iou_threshold: args.iou_threshold,
+        }),
     };
     let start = Instant::now();
-    let rows = track_boxes_with_sort(&args.detections, params, args.min_score)
+    let rows = track_boxes(&args.detections, tracker, args.min_score)
         .context("cannot track the boxes of --detections")?;
     let seconds = start.elapsed().as_secs_f64();
     write_mot_results(&args.out, &rows)
@@ -67,7 +77,7 @@ pub fn run(args: &TrackBoxesArgs) -> Result<()> {
     ids.sort_unstable();
     ids.dedup();
     let summary = Summary {
-        tracker: "sort",
+        tracker: tracker.name(),
         rows: rows.len(),
         tracks: ids.len(),
         frames_per_second: frames as f64 / seconds.max(1e-9),
@@ -77,8 +87,8 @@ pub fn run(args: &TrackBoxesArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         eprintln!(
-            "sort: {} tracks, {} rows → {} ({:.0} frames/s)",
-            summary.tracks, summary.rows, summary.out, summary.frames_per_second
+            "{}: {} tracks, {} rows → {} ({:.0} frames/s)",
+            summary.tracker, summary.tracks, summary.rows, summary.out, summary.frames_per_second
         );
     }
     Ok(())

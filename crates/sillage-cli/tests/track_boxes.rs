@@ -1,6 +1,7 @@
-//! `sillage track boxes` (SORT) on the shared MOT15 detections: the scores of the authors'
-//! SORT (`sort-tracker-py` 1.0.2 on the same detections, `tools/sort_compare.py`), and bad
-//! detection files refused naming the file.
+//! `sillage track boxes` (SORT, ByteTrack) on the shared MOT15 detections: the scores of the
+//! references on the same detections — the authors' SORT (`sort-tracker-py` 1.0.2) and
+//! `supervision` 0.30.9's ByteTrack (`tools/box_trackers_compare.py`) — and bad detection files
+//! refused naming the file.
 
 use std::fs;
 
@@ -25,18 +26,24 @@ fn scores(sequence: &str, pred: &str) -> (f64, f64) {
 }
 
 #[test]
-fn sort_scores_what_the_authors_sort_scores() {
+fn sort_and_bytetrack_score_what_the_references_score() {
     let dir = tempfile::tempdir().unwrap();
-    // The authors' SORT on the same detections (tools/sort_compare.py), scored the same way.
-    for (sequence, mota, idf1) in [
-        ("TUD-Campus", 0.6267, 0.6065),
-        ("TUD-Stadtmitte", 0.7171, 0.7347),
-        ("ETH-Bahnhof", 0.4464, 0.6094),
+    // The references on the same detections (tools/box_trackers_compare.py), scored the same
+    // way.
+    for (tracker, sequence, mota, idf1) in [
+        ("sort", "TUD-Campus", 0.6267, 0.6065),
+        ("sort", "TUD-Stadtmitte", 0.7171, 0.7347),
+        ("sort", "ETH-Bahnhof", 0.4464, 0.6094),
+        ("bytetrack", "TUD-Campus", 0.5961, 0.6656),
+        ("bytetrack", "TUD-Stadtmitte", 0.7093, 0.6776),
+        ("bytetrack", "KITTI-17", 0.5974, 0.6912),
     ] {
-        let out = dir.path().join(format!("{sequence}.txt"));
+        let out = dir.path().join(format!("{tracker}_{sequence}.txt"));
         run_ok(&[
             "track",
             "boxes",
+            "--tracker",
+            tracker,
             "--detections",
             &format!("{MOT15}/{sequence}/det/det.txt"),
             "--out",

@@ -7,7 +7,8 @@
 //!   Kalman IMM and deterministic baselines of its Table 1 (Lafaye de Micheaux et al. 2018).
 //! - [`immpf`]: pedestrians, one IMM particle filter per person with competing motion models
 //!   (Madrigal & Hayet).
-//! - [`sort`]: SORT (Bewley et al. 2016), the box-tracking baseline on detections.
+//! - [`sort`]: SORT (Bewley et al. 2016), the box-tracking baseline on detections;
+//!   [`bytetrack`]: ByteTrack (Zhang et al. 2022), as `supervision` implements it.
 //!
 //! ```
 //! use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker};
@@ -32,6 +33,7 @@
 //! ```
 
 pub mod bedload;
+pub mod bytetrack;
 pub mod immpf;
 pub mod ptv;
 pub mod siftpf;

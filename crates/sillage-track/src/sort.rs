@@ -196,7 +196,7 @@ fn mul7(a: &Covariance, b: &Covariance) -> Covariance {
 
 /// The inverse of a 4×4 matrix by Gauss–Jordan elimination with partial pivoting; `None` when
 /// singular.
-fn invert4(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
+pub(crate) fn invert4(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
     let mut a = *m;
     let mut inv = [[0.0; 4]; 4];
     for (i, row) in inv.iter_mut().enumerate() {

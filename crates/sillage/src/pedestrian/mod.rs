@@ -7,6 +7,7 @@
 //! file's own pixel numbering (MOTChallenge boxes are kept as written, see `sillage_io::mot`),
 //! so the prior, the homography and a tracker's MOTChallenge output agree.
 
+pub mod boxes;
 pub mod ground_plane;
 pub mod homography;
 pub mod immpf;
@@ -15,7 +16,6 @@ pub mod motion;
 pub mod motion_prior;
 pub mod settings;
 pub mod siftpf;
-pub mod sort;
 pub mod walkers;
 
 pub use ground_plane::{FitTable, GroundPlaneFile};
