@@ -507,7 +507,7 @@ def test_fit_learns_what_the_command_line_learns_and_track_takes_it(tmp_path):
 
 def test_bench_gives_the_paper_tables_as_dataframes():
     table = sillage.bench("immpf", [PETS.parent], runs=1, models=["CV_CA"], max_frames=30)
-    assert list(table.models) == ["CV_CA"] and table.runs.iloc[0] == 1
+    assert list(table.models) == ["CV_CA", "SORT", "ByteTrack"] and table.runs.iloc[0] == 1
     assert 0 <= table.median_ata.iloc[0] <= 1
     sift = sillage.bench("siftpf", [PETS.parent], runs=1, selections=["reliability"],
                          max_frames=20)

@@ -15,12 +15,15 @@ use sillage_detect::motion::MotionParams;
 use sillage_eval::papers::vace;
 use sillage_eval::{MotParams, evaluate_mot};
 use sillage_filter::{MotionPrior, MotionPriorParams};
+use sillage_track::bytetrack::ByteTrackParams;
 use sillage_track::immpf::{
     BoxSizing, ModelName, PedestrianEstimate, PedestrianParams, PedestrianTracker,
 };
+use sillage_track::sort::SortParams;
 
 use super::median_over;
 use super::sequences::{SequenceTruth, sequence_name};
+use crate::pedestrian::boxes::{BoxTracker, track_boxes};
 use crate::pedestrian::immpf::{Scene, step};
 use crate::pedestrian::input::{PedestrianInput, PreparedFrame, frame_size_beside};
 use crate::pedestrian::{ImmpfSettings, within};
@@ -110,7 +113,8 @@ pub enum BenchProgress<'a> {
 }
 
 /// Every combination of `combinations` on every sequence folder, each row the medians over
-/// the seeds `1..=runs` (run in parallel). Without a motion prior in `scene`, MP uses one
+/// the seeds `1..=runs` (run in parallel), then SORT and ByteTrack on the sequence's
+/// `det/det.txt`, when it has one, over the same frames (rows `SORT`, `ByteTrack`). Without a motion prior in `scene`, MP uses one
 /// learned from the sequence's own CV_CA tracks ([`self_prior`]).
 pub fn bench(
     folders: &[impl AsRef<Path>],
@@ -155,6 +159,19 @@ pub fn bench(
                 runs: scores.len(),
                 median: RunScores::medians(&scores),
             };
+            on_progress(BenchProgress::Row(&row));
+            rows.push(row);
+        }
+        let baselines = if folder.join("det").join("det.txt").is_file() {
+            vec![
+                BoxTracker::Sort(SortParams::default()),
+                BoxTracker::ByteTrack(ByteTrackParams::default()),
+            ]
+        } else {
+            Vec::new()
+        };
+        for baseline in baselines {
+            let row = sequence.baseline(folder, baseline)?;
             on_progress(BenchProgress::Row(&row));
             rows.push(row);
         }
@@ -230,6 +247,25 @@ impl Sequence {
         Ok((estimates, ms))
     }
 
+    /// A box-tracking baseline on the sequence's `det/det.txt` over the same frames, scored
+    /// as the runs (one row; the baselines are deterministic).
+    fn baseline(&self, folder: &Path, tracker: BoxTracker) -> Result<Row> {
+        let started = Instant::now();
+        let rows = track_boxes(&folder.join("det").join("det.txt"), tracker, None)?;
+        let ms = 1e3 * started.elapsed().as_secs_f64() / self.frames.len().max(1) as f64;
+        let frames = self.frames.len() as u64;
+        let boxes = rows
+            .iter()
+            .filter(|r| r.frame < frames)
+            .filter_map(|r| r.id.map(|id| (r.frame, id, r.bbox())));
+        Ok(Row {
+            sequence: self.name.clone(),
+            models: tracker.label().to_owned(),
+            runs: 1,
+            median: self.score(boxes, ms)?,
+        })
+    }
+
     /// One seeded run, scored.
     fn run_once(
         &self,
@@ -248,6 +284,15 @@ impl Sequence {
             };
             (e.frame, e.track_id, bbox)
         });
+        self.score(boxes, ms)
+    }
+
+    /// The scores of the boxes `(frame, track id, box)` of a run that took `ms` per frame.
+    fn score(
+        &self,
+        boxes: impl Iterator<Item = (FrameIndex, u64, BoundingBox)>,
+        ms: f64,
+    ) -> Result<RunScores> {
         let data = self.truth.data(boxes, self.frames.len() as u64)?;
         let metrics = evaluate_mot(&data, &MotParams::default())?;
         let v = vace(&data);

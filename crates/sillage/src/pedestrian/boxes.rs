@@ -27,6 +27,14 @@ impl BoxTracker {
             Self::ByteTrack(_) => "bytetrack",
         }
     }
+
+    /// The name tables print.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Self::Sort(_) => "SORT",
+            Self::ByteTrack(_) => "ByteTrack",
+        }
+    }
 }
 
 /// Tracks the boxes of `detections` (a MOTChallenge `det.txt`; rows scoring below
