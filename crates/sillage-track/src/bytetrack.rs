@@ -123,14 +123,6 @@ fn xyah(b: &BoundingBox) -> [f64; 4] {
     ]
 }
 
-fn iou(a: &BoundingBox, b: &BoundingBox) -> f64 {
-    let w = (a.right_px().min(b.right_px()) - a.left_px.max(b.left_px)).max(0.0);
-    let h = (a.bottom_px().min(b.bottom_px()) - a.top_px.max(b.top_px)).max(0.0);
-    let inter = w * h;
-    let union = a.width_px * a.height_px + b.width_px * b.height_px - inter;
-    if union > 0.0 { inter / union } else { 0.0 }
-}
-
 impl Track {
     fn bbox(&self) -> BoundingBox {
         let [x, y, a, h] = [self.mean[0], self.mean[1], self.mean[2], self.mean[3]];
@@ -256,7 +248,7 @@ fn iou_costs(tracks: &[&Track], boxes: &[ScoredBox], fuse: bool) -> Vec<f64> {
     for t in tracks {
         let tb = t.bbox();
         for b in boxes {
-            let sim = iou(&tb, &b.bbox) as f32;
+            let sim = tb.iou(&b.bbox) as f32;
             let cost = if fuse {
                 1.0 - sim * b.score as f32
             } else {
@@ -466,17 +458,14 @@ impl ByteTracker {
         let costs = iou_costs(&refs, &left, true);
         let third = assign(&mut self.solver, unconfirmed.len(), left.len(), &costs, 0.7);
         let mut left_matched = vec![false; left.len()];
-        let mut unconfirmed_matched = vec![false; unconfirmed.len()];
+        let mut detection_of = vec![None; unconfirmed.len()];
         for &(t, d) in &third {
             left_matched[d] = true;
-            unconfirmed_matched[t] = true;
+            detection_of[t] = Some(d);
         }
         // Unmatched unconfirmed tracks are removed.
-        for (t, mut track) in unconfirmed.drain(..).enumerate() {
-            if let Some(&(_, d)) = unconfirmed_matched[t]
-                .then(|| third.iter().find(|&&(tt, _)| tt == t))
-                .flatten()
-            {
+        for (mut track, d) in unconfirmed.drain(..).zip(detection_of) {
+            if let Some(d) = d {
                 self.take(&mut track, &left[d].bbox);
                 activated.push(track);
             }
@@ -506,7 +495,7 @@ impl ByteTracker {
         for (a, ta) in tracked.iter().enumerate() {
             let ba = ta.bbox();
             for (b, tb) in lost.iter().enumerate() {
-                let distance = 1.0 - iou(&ba, &tb.bbox()) as f32;
+                let distance = 1.0 - ba.iou(&tb.bbox()) as f32;
                 if distance < 0.05 {
                     let age_a = ta.frame - ta.start_frame;
                     let age_b = tb.frame - tb.start_frame;
@@ -537,7 +526,7 @@ impl ByteTracker {
         let mut costs = Vec::with_capacity(detections.len() * out.len());
         for d in detections {
             for t in &out {
-                costs.push(f64::from(1.0 - iou(&d.bbox, &t.bbox()) as f32));
+                costs.push(f64::from(1.0 - d.bbox.iou(&t.bbox()) as f32));
             }
         }
         let ids: Vec<Option<u64>> = out.iter().map(|t| t.external_id).collect();

@@ -92,14 +92,6 @@ fn state_box(x: &State) -> BoundingBox {
     }
 }
 
-/// Intersection over union of two boxes (0 when they do not overlap).
-fn iou(a: &BoundingBox, b: &BoundingBox) -> f64 {
-    let w = (a.right_px().min(b.right_px()) - a.left_px.max(b.left_px)).max(0.0);
-    let h = (a.bottom_px().min(b.bottom_px()) - a.top_px.max(b.top_px)).max(0.0);
-    let inter = w * h;
-    inter / (a.width_px * a.height_px + b.width_px * b.height_px - inter)
-}
-
 const MEASUREMENT_NOISE: [f64; 4] = [1.0, 1.0, 10.0, 10.0];
 const PROCESS_NOISE: State = [1.0, 1.0, 1.0, 1.0, 0.01, 0.01, 1e-4];
 const INITIAL_VARIANCE: State = [10.0, 10.0, 10.0, 10.0, 1e4, 1e4, 1e4];
@@ -323,7 +315,7 @@ impl SortTracker {
         costs.extend(
             detections
                 .iter()
-                .flat_map(|d| predicted.iter().map(move |t| -iou(d, t))),
+                .flat_map(|d| predicted.iter().map(move |t| -d.iou(t))),
         );
         let iou_of = |d: usize, t: usize| -costs[d * m + t];
         let unique = (0..n).all(|d| (0..m).filter(|&t| iou_of(d, t) > threshold).count() <= 1)

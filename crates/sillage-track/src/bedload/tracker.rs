@@ -17,7 +17,7 @@ use crate::bedload::params::{
     BedloadTrackerKind, BedloadTrackerParams, ObservedVelocity, Prediction, Settings,
 };
 use crate::bedload::particle::{ParticleMotion, Weighting};
-use crate::bedload::smoother::{CONTACT_RATIO_CAP, Evidence, StateChain};
+use crate::bedload::smoother::{CONTACT_RATIO_CAP, Evidence, Smoother, StateChain};
 
 /// Counts over a run, for reports and tests.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -427,7 +427,7 @@ impl BedloadTracker {
 /// Where a tracker's confirmed points go: through its state chain when smoothing, else
 /// straight out.
 struct Emit<'a> {
-    smoother: Option<&'a crate::bedload::smoother::Smoother>,
+    smoother: Option<&'a Smoother>,
     chain: &'a mut StateChain,
     emitted: &'a mut Vec<TrackPoint>,
 }
