@@ -51,7 +51,7 @@ const NO_POINT: u32 = u32::MAX;
 /// ([`PointIndex::rebuild`], [`PointIndex::rebuild_concat`]) to reuse its memory from frame
 /// to frame. The cell size is chosen so that cells hold `occupancy` points on average over
 /// the bounding box. An index holds fewer than 2³² − 1 points.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct PointIndex {
     occupancy: f64,
     len: usize,

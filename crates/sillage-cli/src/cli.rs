@@ -8,6 +8,7 @@ use crate::bench_eulerian::BenchEulerianArgs;
 use crate::bench_immpf::BenchImmpfArgs;
 use crate::bench_ptv_accuracy::BenchPtvAccuracyArgs;
 use crate::bench_siftpf::BenchSiftpfArgs;
+use crate::bench_stream::BenchStreamArgs;
 use crate::demo::DemoArgs;
 use crate::demo_bedload::DemoBedloadArgs;
 use crate::detect::DetectBeadArgs;
@@ -160,6 +161,9 @@ pub enum BenchCommand {
     /// sequences, ETISEO M1-M3 and their mean, CLEAR MOT, IDF1, HOTA and speed, per sequence
     /// and combined.
     Siftpf(BenchSiftpfArgs),
+    /// A long synthetic stream (no files, default 10^6 frames) through PTV or MMPF+: resident
+    /// memory and throughput sampled along the way, track ids checked never to come back.
+    Stream(BenchStreamArgs),
 }
 
 /// `sillage fit <kind>`.

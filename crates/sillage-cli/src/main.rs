@@ -9,6 +9,7 @@ mod bench_eulerian;
 mod bench_immpf;
 mod bench_ptv_accuracy;
 mod bench_siftpf;
+mod bench_stream;
 mod cli;
 mod demo;
 mod demo_bedload;
@@ -56,6 +57,7 @@ fn main() {
         cli::Command::Bench(cli::BenchCommand::Bedload(a)) => bench_bedload::run(&a),
         cli::Command::Bench(cli::BenchCommand::Immpf(a)) => bench_immpf::run(&a),
         cli::Command::Bench(cli::BenchCommand::Siftpf(a)) => bench_siftpf::run(&a),
+        cli::Command::Bench(cli::BenchCommand::Stream(a)) => bench_stream::run(&a),
         cli::Command::Config(a) => ptv::print_config(&a),
         cli::Command::Fit(cli::FitCommand::Bedload(a)) => fit::run_bedload(&a),
         cli::Command::Fit(cli::FitCommand::MotionPrior(a)) => fit_pedestrian::run_motion_prior(&a),

@@ -4,12 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use sillage::PipelineConfig;
-use sillage::io::TrackFormat;
+use serde::Serialize;
+use sillage::io::{SkippedFrame, TrackFormat};
 use sillage::ptv_run::{PtvRun, load_ptv_config};
+use sillage::{PipelineConfig, RunSummary};
 
 use crate::progress::FrameProgress;
-use crate::shared_args::{ConfigArgs, FormatArg, JsonArg};
+use crate::shared_args::{ConfigArgs, FormatArg, JsonArg, LongRunArgs};
 
 /// `sillage ptv`.
 #[derive(Debug, Args)]
@@ -25,6 +26,9 @@ pub struct PtvArgs {
     /// Configuration sources.
     #[command(flatten)]
     pub config: ConfigArgs,
+    /// Bad frames, checkpoints and resume.
+    #[command(flatten)]
+    pub long_run: LongRunArgs,
     /// `--json`: a machine-readable summary on stdout.
     #[command(flatten)]
     pub json: JsonArg,
@@ -56,11 +60,37 @@ pub fn output_format(format: Option<FormatArg>, path: &std::path::Path) -> Resul
     })
 }
 
+/// The `--json` summary of `sillage ptv`: the run's totals, the frames skipped and the
+/// checkpoint resumed from.
+#[derive(Serialize)]
+struct PtvJson<'a> {
+    #[serde(flatten)]
+    summary: &'a RunSummary,
+    skipped_frames: &'a [SkippedFrame],
+    resumed_after_frame: Option<u64>,
+}
+
+/// Tells what a long run skipped and where it resumed (stderr).
+pub fn report_long_run(skipped: &[SkippedFrame], resumed_after: Option<u64>) {
+    if let Some(frame) = resumed_after {
+        eprintln!("resumed after frame {frame} from the checkpoint");
+    }
+    for frame in skipped {
+        eprintln!(
+            "skipped frame {} ({}): {}",
+            frame.index,
+            frame.path.display(),
+            frame.reason
+        );
+    }
+}
+
 /// `sillage ptv INPUT --out FILE`.
 pub fn run(args: &PtvArgs) -> Result<()> {
     let config = load_config(&args.config)?;
     let format = output_format(args.format, &args.out)?;
-    let run = PtvRun::open(&config, &args.input)?;
+    let options = args.long_run.options()?;
+    let run = PtvRun::open_with(&config, &args.input, options.on_bad_frame)?;
     if let Some(used) = run.background_frames() {
         eprintln!("background initialised from the mean of the first {used} frames");
     }
@@ -70,9 +100,12 @@ pub fn run(args: &PtvArgs) -> Result<()> {
         eprintln!("{calibration}");
     }
     let mut progress = FrameProgress::new(run.frame_count(), "tracking");
-    let outcome = run.run_to_file(&args.out, format, &mut |report| progress.frame(report));
+    let outcome = run.run_long(&args.out, format, &options, &mut |report| {
+        progress.frame(report)
+    });
     progress.finish();
     let tracked = outcome?;
+    report_long_run(&tracked.skipped, tracked.resumed_after);
     let summary = tracked.summary;
     if let Some(displacement) = summary.measured_displacement_px {
         let voting = summary.vote_search_px.map_or("off".to_string(), |r| {
@@ -84,7 +117,12 @@ pub fn run(args: &PtvArgs) -> Result<()> {
         );
     }
     if args.json.enabled {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        let json = PtvJson {
+            summary: &summary,
+            skipped_frames: &tracked.skipped,
+            resumed_after_frame: tracked.resumed_after,
+        };
+        println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         eprintln!(
             "{} frames, {} detections, {} track points in {} tracks → {} ({:.2} ms/frame detection, {:.2} ms/frame tracking)",

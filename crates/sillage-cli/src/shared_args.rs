@@ -139,3 +139,65 @@ pub struct BeadDetectorArgs {
     #[arg(long = "detector-set", value_name = "KEY=VALUE")]
     pub detector_overrides: Vec<String>,
 }
+
+/// What to do with a frame that cannot be read (`--on-bad-frame`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum BadFrameArg {
+    /// Stop with an error naming the frame.
+    #[default]
+    Stop,
+    /// Skip it, as a missed frame (trackers predict through it), and report it.
+    Skip,
+}
+
+/// `--on-bad-frame`, `--checkpoint-every` and `--resume`: long runs that survive bad
+/// frames, crashes and signals.
+#[derive(Debug, Args, Clone)]
+pub struct LongRunArgs {
+    /// A frame that does not decode, has the wrong size or is missing from a numbered
+    /// sequence: stop there, or skip it as a missed frame and report it.
+    #[arg(long, value_enum, default_value_t = BadFrameArg::Stop)]
+    pub on_bad_frame: BadFrameArg,
+    /// Save a checkpoint every N frames (and when stopped by Ctrl-C or SIGTERM) beside the
+    /// output, as `OUT.checkpoint`; rows are spooled beside it and the output is written at
+    /// the end.
+    #[arg(long, value_name = "N")]
+    pub checkpoint_every: Option<u64>,
+    /// Continue an interrupted run from its checkpoint (same command and settings); the
+    /// output is the one an uninterrupted run writes. Without a checkpoint the run starts
+    /// from the first frame.
+    #[arg(long, requires = "checkpoint_every")]
+    pub resume: bool,
+}
+
+impl LongRunArgs {
+    /// The library's options, with a stop flag raised by Ctrl-C or SIGTERM when checkpoints
+    /// are saved (the run saves one, then stops).
+    pub fn options(&self) -> anyhow::Result<sillage::long_run::LongRunOptions> {
+        let stop = match self.checkpoint_every {
+            Some(_) => {
+                let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+                let raised = flag.clone();
+                ctrlc::set_handler(move || {
+                    raised.store(true, std::sync::atomic::Ordering::Relaxed);
+                })?;
+                Some(flag)
+            }
+            None => None,
+        };
+        Ok(sillage::long_run::LongRunOptions {
+            on_bad_frame: self.policy(),
+            checkpoint_every: self.checkpoint_every,
+            resume: self.resume,
+            stop,
+        })
+    }
+
+    /// The bad-frame policy.
+    pub fn policy(&self) -> sillage::io::BadFramePolicy {
+        match self.on_bad_frame {
+            BadFrameArg::Stop => sillage::io::BadFramePolicy::Stop,
+            BadFrameArg::Skip => sillage::io::BadFramePolicy::Skip,
+        }
+    }
+}

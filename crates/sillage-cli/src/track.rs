@@ -12,16 +12,19 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 use sillage::bedload::detector::BeadDetectorSources;
 use sillage::bedload::output::{BeadTrackKind, BeadTrackOutput};
-use sillage::bedload::read_bead_frames;
-use sillage::io::{FrameOptions, TrackFormat, open_frames};
-use sillage::toml_config::load_unvalidated;
+use sillage::bedload::{BeadFrame, read_bead_frames};
+use sillage::checkpoint::RunIdentity;
+use sillage::io::{FrameOptions, SkippedFrame, TrackFormat, TrackWriter, open_frames};
+use sillage::long_run::{Inputs, LongRunOutput, OpenInputs, run_long};
+use sillage::toml_config::{dotted_keys, load_unvalidated};
 use sillage::track::bedload::BedloadTrackerParams;
 use sillage::viz::OverlayStyle;
 use sillage::{DetectorConfig, FrameInput, Pipeline, PipelineConfig, TrackerConfig};
 
 use crate::overlay::{DetectionsByFrame, write_overlays};
 use crate::progress::FrameProgress;
-use crate::shared_args::{BeadDetectorArgs, ConfigFileArgs, JsonArg};
+use crate::ptv::report_long_run;
+use crate::shared_args::{BeadDetectorArgs, ConfigFileArgs, JsonArg, LongRunArgs};
 
 /// The trackers of `sillage track bedload --tracker`.
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -107,6 +110,9 @@ pub struct TrackBedloadArgs {
     /// Frames of history in each overlay tail.
     #[arg(long, value_name = "FRAMES", default_value_t = 20)]
     pub overlay_tail: u64,
+    /// Bad frames, checkpoints and resume.
+    #[command(flatten)]
+    pub long_run: LongRunArgs,
     /// `--json`: a machine-readable summary on stdout.
     #[command(flatten)]
     pub json: JsonArg,
@@ -131,8 +137,9 @@ pub fn load_bedload_params(args: &TrackBedloadArgs) -> Result<BedloadTrackerPara
 struct TrackSummary {
     tracker: &'static str,
     frames: u64,
-    detections: usize,
-    candidates: usize,
+    detections: u64,
+    candidates: u64,
+    skipped_frames: Vec<SkippedFrame>,
     tracks: u64,
     points: u64,
     coasted_points: u64,
@@ -141,15 +148,9 @@ struct TrackSummary {
     out: String,
 }
 
-/// The frames to track (their number when known).
-type Inputs = (
-    Option<usize>,
-    Box<dyn Iterator<Item = sillage::core::Result<FrameInput>>>,
-);
-
 /// The frames of `--detections` (with `--candidates`), refusing an `--out` that would
 /// overwrite one of them.
-fn read_inputs(args: &TrackBedloadArgs, detections: &Path) -> Result<Inputs> {
+fn read_inputs(args: &TrackBedloadArgs, detections: &Path) -> Result<Vec<BeadFrame>> {
     let inputs = std::iter::once(detections).chain(args.candidates.as_deref());
     for input in inputs {
         let same = match (input.canonicalize(), args.out.canonicalize()) {
@@ -163,11 +164,7 @@ fn read_inputs(args: &TrackBedloadArgs, detections: &Path) -> Result<Inputs> {
             input.display()
         );
     }
-    let frames = read_bead_frames(detections, args.candidates.as_deref())?;
-    Ok((
-        Some(frames.len()),
-        Box::new(frames.into_iter().map(|f| Ok(f.into()))),
-    ))
+    Ok(read_bead_frames(detections, args.candidates.as_deref())?)
 }
 
 /// The track file kind of `--format` (`None`: from the extension of `--out`).
@@ -183,51 +180,96 @@ fn output_kind(format: Option<BeadFormatArg>) -> Option<BeadTrackKind> {
 /// `sillage track bedload [FRAMES | --detections FILE] --out FILE`.
 pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     let params = load_bedload_params(args)?;
+    let options = args.long_run.options()?;
     let mut config = PipelineConfig {
         tracker: TrackerConfig::Bedload(Box::new(params.clone())),
         ..PipelineConfig::default()
     };
-    let (total, inputs): Inputs = match (&args.input, &args.detections) {
-        (Some(input), _) => {
-            let sources = BeadDetectorSources::from(&args.detector);
-            config.detector = DetectorConfig::Bead(sources.load()?);
-            let frames = open_frames(input, &FrameOptions::default())?;
-            (
-                frames.len(),
-                Box::new(frames.map(|f| f.map(FrameInput::Image))),
-            )
-        }
-        (None, Some(detections)) => read_inputs(args, detections)?,
-        (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
-    };
+    let (total, source, mut open_inputs): (Option<usize>, String, Box<OpenInputs<'_>>) =
+        match (&args.input, &args.detections) {
+            (Some(input), _) => {
+                let sources = BeadDetectorSources::from(&args.detector);
+                config.detector = DetectorConfig::Bead(sources.load()?);
+                let frame_options = FrameOptions {
+                    on_bad_frame: options.on_bad_frame,
+                    ..FrameOptions::default()
+                };
+                let total = open_frames(input, &frame_options)?.len();
+                let source = input.clone();
+                let input = input.clone();
+                let open = move |start_at| -> sillage::core::Result<Inputs<'static>> {
+                    let options = FrameOptions {
+                        start_at,
+                        ..frame_options.clone()
+                    };
+                    let frames = open_frames(&input, &options)?;
+                    let log = frames.skipped();
+                    Ok((
+                        Box::new(frames.map(|f| f.map(FrameInput::Image))),
+                        Some(log),
+                    ))
+                };
+                (total, source, Box::new(open))
+            }
+            (None, Some(detections)) => {
+                let frames = read_inputs(args, detections)?;
+                let open = move |start_at| -> sillage::core::Result<Inputs<'static>> {
+                    let from: Vec<BeadFrame> = frames
+                        .iter()
+                        .filter(|f| f.frame >= start_at)
+                        .cloned()
+                        .collect();
+                    Ok((Box::new(from.into_iter().map(|f| Ok(f.into()))), None))
+                };
+                (None, detections.display().to_string(), Box::new(open))
+            }
+            (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
+        };
     if let Some(total) = total {
         params.check_sequence_length(total)?;
     }
+    let kind = match output_kind(args.format) {
+        Some(kind) => kind,
+        None => BeadTrackKind::from_path(&args.out)?,
+    };
     let mut pipeline = Pipeline::from_config(&config)?;
-    let mut writer = BeadTrackOutput::create(&args.out, output_kind(args.format), &params)?;
-    let kind = writer.kind();
+    let mut create_writer = || -> sillage::core::Result<Box<dyn TrackWriter + Send>> {
+        Ok(Box::new(BeadTrackOutput::create(
+            &args.out,
+            Some(kind),
+            &params,
+        )?))
+    };
+    let mut settings = dotted_keys(&config)?;
+    settings.push(("format".to_string(), format!("{kind:?}")));
+    settings.extend(options.settings());
+    let output = LongRunOutput {
+        path: &args.out,
+        create_writer: &mut create_writer,
+        identity: RunIdentity::new("track bedload", &source, &args.out, settings),
+    };
     let mut progress = FrameProgress::new(total, "tracking");
     let start = Instant::now();
-    let (mut n_detections, mut n_candidates) = (0, 0);
+    let mut frames_here = 0u64;
     let mut kept = DetectionsByFrame::new();
-    let outcome = pipeline.run_inputs(inputs, &mut writer, &mut |report, observations| {
-        n_detections += report.detections;
-        n_candidates += report.candidates;
-        if args.overlay.is_some() {
-            kept.insert(report.frame, observations.detections.to_vec());
-        }
-        progress.tick();
-    });
+    let outcome = run_long(
+        &mut pipeline,
+        &mut open_inputs,
+        output,
+        &options,
+        &mut |report, observations| {
+            frames_here += 1;
+            if args.overlay.is_some() {
+                kept.insert(report.frame, observations.detections.to_vec());
+            }
+            progress.tick();
+        },
+    );
     progress.finish();
     let elapsed = start.elapsed().as_secs_f64();
-    // Rows written before an error stay valid: the file is completed either way.
-    let written = writer.finish()?;
-    let source = match (&args.input, &args.detections) {
-        (Some(input), _) => input.clone(),
-        (None, Some(path)) => path.display().to_string(),
-        (None, None) => String::new(),
-    };
-    outcome.with_context(|| format!("while tracking {source}"))?;
+    let tracked = outcome.with_context(|| format!("while tracking {source}"))?;
+    report_long_run(&tracked.skipped, tracked.resumed_after);
+    let written = tracked.written;
     if let (Some(dir), Some(input)) = (&args.overlay, &args.input) {
         let tracks = kind.read(&written.path)?;
         let style = OverlayStyle {
@@ -242,13 +284,14 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     let summary = TrackSummary {
         tracker: params.tracker.name(),
         frames: stats.frames,
-        detections: n_detections,
-        candidates: n_candidates,
+        detections: tracked.summary.detections,
+        candidates: tracked.summary.candidates,
+        skipped_frames: tracked.skipped,
         tracks: stats.tracks,
         points: written.rows,
         coasted_points: stats.coasted,
         weight_recoveries: stats.weight_recoveries,
-        ms_per_frame: 1e3 * elapsed / stats.frames.max(1) as f64,
+        ms_per_frame: 1e3 * elapsed / frames_here.max(1) as f64,
         out: written.path.display().to_string(),
     };
     if args.json.enabled {

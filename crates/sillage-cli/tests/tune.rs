@@ -198,6 +198,29 @@ fn api_names_what_is_wrong() {
     assert_eq!(error("GET", "/nowhere", None).0, 404);
     assert_eq!(error("GET", "/api/detect", None).0, 405);
     assert_eq!(error("GET", "/frame/x.png", None).0, 400);
+    // No path reaches a file: frames are named by index, the save path is fixed at start.
+    for path in [
+        "/frame/../../etc/passwd",
+        "/frame/..%2F..%2Fetc%2Fpasswd.png",
+        "/frame/-1.png",
+    ] {
+        assert_eq!(error("GET", path, None).0, 400, "{path}");
+    }
+    for path in ["/../Cargo.toml", "/%2e%2e/etc/passwd", "/t.toml"] {
+        assert_eq!(error("GET", path, None).0, 404, "{path}");
+    }
+    // An oversized body is refused before it is read, and the server stays up.
+    let mut stream = std::net::TcpStream::connect(("127.0.0.1", server.port)).unwrap();
+    std::io::Write::write_all(
+        &mut stream,
+        b"POST /api/save HTTP/1.1\r\nContent-Length: 999999999\r\n\r\n",
+    )
+    .unwrap();
+    let mut reply = String::new();
+    std::io::Read::read_to_string(&mut stream, &mut reply).unwrap();
+    assert!(reply.starts_with("HTTP/1.1 413"), "{reply}");
+    assert!(!dir.path().join("t.toml").exists());
+    assert_eq!(call(&server, "GET", "/api/state", None).0, 200);
 
     let (status, png) = http(server.port, "GET", "/frame/1.png", None);
     assert_eq!(status, 200);

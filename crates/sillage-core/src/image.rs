@@ -3,7 +3,7 @@
 use crate::{Error, Result};
 
 /// A row-major image of `width × height` pixels of type `T`.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Image<T> {
     width: usize,
     height: usize,

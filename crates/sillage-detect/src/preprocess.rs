@@ -67,7 +67,7 @@ impl PreprocessParams {
 /// so far until `init_frames` have been seen, so the first frames have a weak foreground
 /// (frame 0's is `I·mask − I`); after that, each frame moves it by at most β (Eq. (1)).
 /// `F` is always computed against the background of the previous frames.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Preprocessor {
     params: PreprocessParams,
     background: Option<BackgroundModel>,

@@ -14,7 +14,7 @@ use crate::weights::normalise;
 
 /// Validated [`FilterParams`] and the run seed: spawns the filter of each new target, each with
 /// its own random stream `rng_stream(seed, track_id)`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FilterSpec {
     particles: usize,
     resampling: Resampling,
@@ -57,7 +57,7 @@ impl FilterSpec {
 }
 
 /// What the weighting and resampling of one step found.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StepReport {
     /// `ln p(zₜ | z₁..ₜ₋₁)` as the particles estimate it (−∞ when every weight was zero).
     pub log_evidence: f64,
@@ -71,7 +71,7 @@ pub struct StepReport {
 }
 
 /// The particle filter of one target: its particles, its random stream and its counters.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ParticleFilter {
     track_id: TrackId,
     rng: RngStream,

@@ -21,7 +21,7 @@ use crate::switching::TransitionTable;
 use crate::weights::log_sum_exp;
 
 /// A Kalman IMM over an `N`-dimensional state whose first two components are the position.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct KalmanImm<const N: usize> {
     models: Vec<LinearGaussian<N>>,
     table: TransitionTable,

@@ -10,7 +10,7 @@ use crate::linalg::{Gaussian, Matrix, Vector};
 use crate::noise::Noise2;
 
 /// A linear-Gaussian motion `x ← F·x + w`, `w ~ N(0, Q)`, one frame per step.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LinearGaussian<const N: usize> {
     /// F, the state transition.
     pub transition: Matrix<N, N>,
@@ -19,7 +19,7 @@ pub struct LinearGaussian<const N: usize> {
 }
 
 /// A validated position measurement noise R (positive definite), px².
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PositionMeasurement {
     noise: Matrix<2, 2>,
 }
@@ -41,7 +41,7 @@ impl PositionMeasurement {
 
 /// The Kalman filter: a Gaussian belief, predicted by a [`LinearGaussian`] motion and updated
 /// by a position measurement (Joseph form, so the covariance stays symmetric and positive).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct KalmanFilter<const N: usize> {
     /// The current belief.
     pub state: Gaussian<N>,

@@ -13,6 +13,31 @@ pub struct Matrix<const R: usize, const C: usize>(pub [[f64; C]; R]);
 /// A column vector of `N` entries.
 pub type Vector<const N: usize> = Matrix<N, 1>;
 
+/// Serialised as its `R·C` entries in row-major order (serde derives arrays of fixed sizes
+/// only, not of const-generic ones); checkpoints of the filters carry their matrices.
+impl<const R: usize, const C: usize> serde::Serialize for Matrix<R, C> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.0.iter().flatten())
+    }
+}
+
+impl<'de, const R: usize, const C: usize> serde::Deserialize<'de> for Matrix<R, C> {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let entries = Vec::<f64>::deserialize(deserializer)?;
+        if entries.len() != R * C {
+            return Err(serde::de::Error::invalid_length(
+                entries.len(),
+                &format!("{} entries of a {R}×{C} matrix", R * C).as_str(),
+            ));
+        }
+        let mut out = Self::ZERO;
+        for (slot, value) in out.0.iter_mut().flatten().zip(entries) {
+            *slot = value;
+        }
+        Ok(out)
+    }
+}
+
 impl<const R: usize, const C: usize> Matrix<R, C> {
     /// The zero matrix.
     pub const ZERO: Self = Matrix([[0.0; C]; R]);
@@ -187,7 +212,7 @@ impl<const R: usize, const C: usize> Sub for Matrix<R, C> {
 
 /// A Gaussian density over an `N`-dimensional state: the Kalman filter's belief and the
 /// particle filter's weighted moments, so the two compare directly.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Gaussian<const N: usize> {
     /// Mean.
     pub mean: Vector<N>,

@@ -92,7 +92,7 @@ impl Noise2 {
 }
 
 /// A validated 2-D Gaussian noise, stored as its lower Cholesky factor for sampling.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Gauss2 {
     l11: f64,
     l21: f64,

@@ -62,7 +62,7 @@ pub struct InitialSpread {
 
 /// The N particles of one target, with their log weights and the scratch buffers the
 /// resampling gather reuses from step to step.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Particles {
     pos_x: Vec<f64>,
     pos_y: Vec<f64>,

@@ -67,7 +67,7 @@ impl Resampling {
 }
 
 /// Draws ancestor indices; owns its buffers so that a filter reuses them at every step.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct Resampler {
     ancestors: Vec<u32>,
     positions: Vec<f64>,

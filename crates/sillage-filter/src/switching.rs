@@ -9,7 +9,7 @@ pub const ROW_SUM_TOLERANCE: f64 = 1e-9;
 
 /// A validated transition table: `rows` from-states × `columns` to-states, non-negative, each
 /// row summing to 1. Rows may outnumber columns (an initial "unknown" state that is only left).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TransitionTable {
     columns: usize,
     probabilities: Vec<f64>,

@@ -16,7 +16,7 @@ const CHUNK: usize = 1 << 14;
 /// `r₂ = B − I`, `B ← clip(B + r, 0, 1)` where `r = −β` if `r₂ > β`, `+β` if `r₂ < −β` and
 /// `−r₂` otherwise. That is Eq. (1), `B += β·sign(I − B)`, with a dead band so that `B` lands
 /// exactly on `I` instead of oscillating around it.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BackgroundModel {
     background: GrayImage,
     speed: f32,

@@ -69,6 +69,7 @@ mod mot;
 mod mot_events;
 mod numeric_table;
 mod partial;
+mod spool;
 mod table_format;
 mod text_table;
 mod tracks;
@@ -84,8 +85,8 @@ pub use detections::{
     DETECTIONS_HEADER, DetectionsCsvWriter, read_detections_csv, write_detections_csv,
 };
 pub use frames::{
-    Frame, FrameOptions, FrameSource, Mp4Writer, open_frames, read_image, write_png_rgb,
-    write_png16, write_text,
+    BadFramePolicy, Frame, FrameOptions, FrameSource, Mp4Writer, SkippedFrame, SkippedFrames,
+    open_frames, read_image, read_image_from_bytes, write_png_rgb, write_png16, write_text,
 };
 pub use matrix::read_matrix_csv;
 pub use mot::{
@@ -96,6 +97,7 @@ pub use mot::{
 pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
 pub use numeric_table::{ColumnValues, NumericFormat, NumericTable, write_numeric_table};
 pub use partial::PartialFile;
+pub use spool::{SpoolWriter, replay_spool, spool_path};
 pub use table_format::{TableFormat, detect_table_format};
 pub use tracks::{
     BackgroundWriter, QUEUED_BATCHES, STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE,

@@ -68,6 +68,19 @@ impl PartialFile {
         Ok(final_path)
     }
 
+    /// [`PartialFile::commit`] after syncing the data to the disk: for files that a run
+    /// relies on after a crash (checkpoints), which must never name data not yet written.
+    pub fn commit_synced(mut self) -> Result<PathBuf> {
+        self.writer
+            .flush()
+            .map_err(|e| Error::io(&self.partial_path, e))?;
+        self.writer
+            .get_ref()
+            .sync_all()
+            .map_err(|e| Error::io(&self.partial_path, e))?;
+        self.commit()
+    }
+
     /// Gives up: removes the partial file (used when a one-shot write fails half way).
     pub fn abandon(self) {
         let Self {

@@ -299,6 +299,45 @@ fn constant_acceleration_kinematics_follow_eqs_6_and_7() {
 }
 
 #[test]
+fn a_missing_frame_keeps_identities_and_exact_kinematics() {
+    // Frame 5 is missing (a skipped bad frame): frame 4 links to frame 6 over two steps.
+    let (v, a) = (Vec2::new(2.0, -1.0), Vec2::new(0.1, 0.05));
+    let scene = Scene::new(
+        5,
+        20,
+        12,
+        jittered_lattice(100.0),
+        |p, t| p + v * t + a * (0.5 * t * t),
+        1.0,
+        0,
+    );
+    let mut tracker = PtvTracker::new(PtvParams::default()).unwrap();
+    let mut points = Vec::new();
+    for f in (0..12u64).filter(|&f| f != 5) {
+        let obs = FrameObservations::from_detections(f, &scene.frames[f as usize]);
+        tracker.step(&obs, &mut points).unwrap();
+    }
+    // Every frame but the first, the last and the missing one, each particle once.
+    assert_eq!(points.len(), 20 * 9);
+    let ids = scene.true_ids();
+    let mut track_of: HashMap<u64, u64> = HashMap::new();
+    for p in &points {
+        assert_ne!(p.frame, 5);
+        let truth = ids[&(p.frame, p.pos_px.x.to_bits(), p.pos_px.y.to_bits())];
+        assert_eq!(*track_of.entry(truth).or_insert(p.track_id), p.track_id);
+        let t = p.frame as f64;
+        // The three-point derivatives for unequal steps are exact on a parabola.
+        assert!((p.vel_px_per_frame.unwrap() - (v + a * t)).max_abs() < 1e-9);
+        assert!((p.acc_px_per_frame2.unwrap() - a).max_abs() < 1e-9);
+    }
+    assert_eq!(
+        track_of.len(),
+        20,
+        "one identity per particle across the gap"
+    );
+}
+
+#[test]
 fn outlier_filter_rejects_an_injected_wrong_link_and_keeps_the_id() {
     let vel = Vec2::new(1.0, 0.0);
     let mut scene = Scene::new(

@@ -4,8 +4,8 @@
 //! a tracking run sees.
 
 use sillage_core::{Detection, Detector, Error, GrayImage, Result};
+use sillage_detect::Preprocessor;
 use sillage_detect::blob::{BlobDetector, Calibration};
-use sillage_detect::preprocess::Preprocessor;
 use sillage_detect::{BeadDetections, BeadDetector};
 use sillage_io::Frame;
 
@@ -75,6 +75,16 @@ impl DetectionStage {
         frames: impl IntoIterator<Item = &'a GrayImage>,
     ) -> Result<usize> {
         self.preprocessor.prime(frames)
+    }
+
+    /// The pre-processing and its state (the background model), for checkpoints.
+    pub fn preprocessor(&self) -> &Preprocessor {
+        &self.preprocessor
+    }
+
+    /// Continues with the pre-processing state `preprocessor` (a resumed run).
+    pub fn set_preprocessor(&mut self, preprocessor: Preprocessor) {
+        self.preprocessor = preprocessor;
     }
 
     /// Pre-processes and detects `frame` into `out`. Errors name the frame and its file when

@@ -28,6 +28,7 @@
 //! ```
 
 pub mod bedload;
+pub mod checkpoint;
 pub mod config;
 pub mod demo;
 pub mod detection_stage;
@@ -37,6 +38,7 @@ mod eulerian_plots;
 pub mod evaluate;
 pub mod experiments;
 mod folders;
+pub mod long_run;
 pub mod overlay;
 pub mod pedestrian;
 pub mod pipeline;
@@ -46,6 +48,7 @@ pub mod ptv_accuracy_bench;
 pub mod ptv_bench;
 pub mod ptv_files_bench;
 pub mod ptv_run;
+pub mod stream_bench;
 pub mod tables;
 pub mod toml_config;
 pub mod tracking;
@@ -56,7 +59,9 @@ pub mod vortex_files;
 
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
 pub use detection_stage::DetectionStage;
-pub use pipeline::{FrameInput, FrameObserver, FrameReport, Pipeline, RunSummary};
+pub use pipeline::{
+    FrameInput, FrameObserver, FrameReport, Pipeline, PipelineState, RunSummary, RunTally,
+};
 pub use tracking::{Detecting, Tracking, detect_source, track_source};
 
 pub use sillage_assoc as assoc;

@@ -6,6 +6,7 @@ use sillage_core::{
     Detection, DiscardSink, Error, FrameIndex, FrameObservations, Result, TrackPoint, TrackSink,
     Tracker,
 };
+use sillage_detect::Preprocessor;
 use sillage_detect::blob::Calibration;
 use sillage_io::Frame;
 use sillage_track::bedload::{BedloadStats, BedloadTracker};
@@ -15,6 +16,7 @@ use crate::config::{PipelineConfig, TrackerConfig};
 use crate::detection_stage::DetectionStage;
 
 /// The built-in trackers, chosen by [`TrackerConfig`].
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 enum AnyTracker {
     Ptv(PtvTracker),
     Bedload(BedloadTracker),
@@ -90,6 +92,8 @@ pub struct RunSummary {
     pub frames: u64,
     /// Detections over all frames.
     pub detections: u64,
+    /// Detector-confidence candidates over all frames (bedload trackers).
+    pub candidates: u64,
     /// Track points written.
     pub points: u64,
     /// Distinct trajectories among them.
@@ -108,6 +112,22 @@ pub struct RunSummary {
     pub vote_search_px: Option<f64>,
 }
 
+/// Wall time spent per stage over the frames of a run.
+#[derive(Debug, Default)]
+struct Timings {
+    frames: u64,
+    detect: Duration,
+    track: Duration,
+}
+
+impl Timings {
+    fn add(&mut self, report: &FrameReport) {
+        self.frames += 1;
+        self.detect += report.detect_time;
+        self.track += report.track_time;
+    }
+}
+
 /// A configured detector and tracker, fed one frame at a time.
 pub struct Pipeline {
     stage: DetectionStage,
@@ -123,35 +143,52 @@ pub struct Pipeline {
 /// what the tracker saw.
 pub type FrameObserver<'a> = dyn FnMut(&FrameReport, &FrameObservations<'_>) + 'a;
 
-/// Counts what passes through to the real sink, so the run summary needs no second look.
-struct CountingSink<'a> {
-    inner: &'a mut dyn TrackSink,
-    points: u64,
+/// The counts of a run so far (frames, detections, points, tracks): the totals of its
+/// summary, carried in a checkpoint so that a resumed run reports the same ones.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct RunTally {
+    /// Frames of the output pass tracked.
+    pub frames: u64,
+    /// The last of them (`None` before the first).
+    pub last_frame: Option<FrameIndex>,
+    /// Detections over those frames.
+    pub detections: u64,
+    /// Detector-confidence candidates shown to the tracker with them.
+    pub candidates: u64,
+    /// Track points handed to the sink.
+    pub points: u64,
+    /// Distinct trajectories among them.
+    pub tracks: u64,
+    /// The highest track id seen.
     max_track_id: Option<u64>,
-    track_ids_seen: u64,
 }
 
-impl<'a> CountingSink<'a> {
-    fn new(inner: &'a mut dyn TrackSink) -> Self {
-        Self {
-            inner,
-            points: 0,
-            max_track_id: None,
-            track_ids_seen: 0,
-        }
-    }
+/// The state of a pipeline between two frames, for checkpoints: the tracker's (its
+/// particles and random streams included) and the pre-processing's (the background model).
+/// Detector scratch and settings are rebuilt from the configuration.
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct PipelineState {
+    tracker: AnyTracker,
+    preprocessor: Preprocessor,
 }
 
-impl TrackSink for CountingSink<'_> {
+/// Counts what passes through to the real sink, so the run summary needs no second look.
+struct CountingSink<'a, S: ?Sized> {
+    inner: &'a mut S,
+    tally: &'a mut RunTally,
+}
+
+impl<S: TrackSink + ?Sized> TrackSink for CountingSink<'_, S> {
     fn accept(&mut self, points: &[TrackPoint]) -> Result<()> {
+        let tally = &mut *self.tally;
         for p in points {
             // Track ids are handed out in increasing order, so a new maximum is a new track.
-            if self.max_track_id.is_none_or(|m| p.track_id > m) {
-                self.max_track_id = Some(p.track_id);
-                self.track_ids_seen += 1;
+            if tally.max_track_id.is_none_or(|m| p.track_id > m) {
+                tally.max_track_id = Some(p.track_id);
+                tally.tracks += 1;
             }
         }
-        self.points += points.len() as u64;
+        tally.points += points.len() as u64;
         self.inner.accept(points)
     }
 }
@@ -294,45 +331,117 @@ impl Pipeline {
         sink: &mut dyn TrackSink,
         on_frame: &mut FrameObserver<'_>,
     ) -> Result<RunSummary> {
-        let mut counting = CountingSink::new(sink);
-        let mut totals = RunSummary::default();
-        let (mut detect_time, mut track_time) = (Duration::ZERO, Duration::ZERO);
-        let mut add = |report: &FrameReport, observations: &FrameObservations<'_>| {
-            detect_time += report.detect_time;
-            track_time += report.track_time;
-            totals.frames += 1;
-            totals.detections += report.detections as u64;
-            on_frame(report, observations);
-        };
         if self.training_passes == 0 {
-            for input in inputs {
-                self.step_output_pass(&input?, &mut counting, &mut add)?;
-            }
-        } else {
-            let cached = self.detect_all(inputs)?;
-            self.train(&cached)?;
-            self.tracker.start_pass(PassDirection::Forward);
-            // Training passes replay detections only: PTV, the tracker that trains, takes no
-            // candidates.
-            self.candidates.clear();
-            for (index, detections, detect) in &cached {
-                self.detections.clone_from(detections);
-                self.track(*index, None, *detect, &mut counting, &mut add)?;
-            }
+            return self.run_resumable(
+                inputs,
+                sink,
+                RunTally::default(),
+                on_frame,
+                &mut |_, _, _| Ok(()),
+            );
         }
-        self.tracker.as_tracker().finish(&mut counting)?;
-        totals.points = counting.points;
-        totals.tracks = counting.track_ids_seen;
-        totals.detector = self.stage.calibration();
+        let mut tally = RunTally::default();
+        let mut timings = Timings::default();
+        let cached = self.detect_all(inputs)?;
+        self.train(&cached)?;
+        self.tracker.start_pass(PassDirection::Forward);
+        // Training passes replay detections only: PTV, the tracker that trains, takes no
+        // candidates.
+        self.candidates.clear();
+        for (index, detections, detect) in &cached {
+            self.detections.clone_from(detections);
+            let report = self.track(*index, None, *detect, sink, &mut tally, on_frame)?;
+            timings.add(&report);
+        }
+        self.finish_run(sink, tally, timings)
+    }
+
+    /// The output pass of a run without training passes, from `tally` on: a fresh run starts
+    /// from [`RunTally::default`], a resumed one from its checkpoint's tally with the state
+    /// of [`Pipeline::restore`] and the frames after the checkpoint's last. After every
+    /// frame `after_frame` gets the pipeline, the tally and the sink (a checkpoint is saved
+    /// there); an error from it ends the run.
+    pub fn run_resumable<S: TrackSink + ?Sized>(
+        &mut self,
+        inputs: impl Iterator<Item = Result<FrameInput>>,
+        sink: &mut S,
+        mut tally: RunTally,
+        on_frame: &mut FrameObserver<'_>,
+        after_frame: &mut dyn FnMut(&Self, &RunTally, &mut S) -> Result<()>,
+    ) -> Result<RunSummary> {
+        if self.training_passes > 0 {
+            return Err(Error::parameter(
+                "training_passes",
+                self.training_passes,
+                "training passes replay the whole sequence, which a run that can be resumed \
+                 does not keep; set it to 0",
+            ));
+        }
+        let mut timings = Timings::default();
+        for input in inputs {
+            let report = self.step_output_pass(&input?, &mut *sink, &mut tally, on_frame)?;
+            timings.add(&report);
+            after_frame(self, &tally, sink)?;
+        }
+        self.finish_run(sink, tally, timings)
+    }
+
+    /// Flushes the tracker and turns the tally and timings into the run's summary.
+    fn finish_run<S: TrackSink + ?Sized>(
+        &mut self,
+        sink: &mut S,
+        mut tally: RunTally,
+        timings: Timings,
+    ) -> Result<RunSummary> {
+        self.tracker.as_tracker().finish(&mut CountingSink {
+            inner: &mut *sink,
+            tally: &mut tally,
+        })?;
+        let mut totals = RunSummary {
+            frames: tally.frames,
+            detections: tally.detections,
+            candidates: tally.candidates,
+            points: tally.points,
+            tracks: tally.tracks,
+            detector: self.stage.calibration(),
+            ..RunSummary::default()
+        };
         if let AnyTracker::Ptv(tracker) = &self.tracker {
             totals.measured_displacement_px = tracker.measured_displacement();
             totals.vote_search_px = tracker.vote_radius();
         }
-        if totals.frames > 0 {
-            totals.detect_ms_per_frame = detect_time.as_secs_f64() * 1e3 / totals.frames as f64;
-            totals.track_ms_per_frame = track_time.as_secs_f64() * 1e3 / totals.frames as f64;
+        if timings.frames > 0 {
+            let per_frame = |d: Duration| d.as_secs_f64() * 1e3 / timings.frames as f64;
+            totals.detect_ms_per_frame = per_frame(timings.detect);
+            totals.track_ms_per_frame = per_frame(timings.track);
         }
         Ok(totals)
+    }
+
+    /// The tracker's and the pre-processing's state now (see [`PipelineState`]).
+    pub fn state(&self) -> PipelineState {
+        PipelineState {
+            tracker: self.tracker.clone(),
+            preprocessor: self.stage.preprocessor().clone(),
+        }
+    }
+
+    /// Continues from `state`, saved by a pipeline of the same configuration; a state of
+    /// another tracker is refused.
+    pub fn restore(&mut self, state: PipelineState) -> Result<()> {
+        let same_kind = matches!(
+            (&self.tracker, &state.tracker),
+            (AnyTracker::Ptv(_), AnyTracker::Ptv(_))
+                | (AnyTracker::Bedload(_), AnyTracker::Bedload(_))
+        );
+        if !same_kind {
+            return Err(Error::input(
+                "the saved state is of another tracker than the configuration's",
+            ));
+        }
+        self.tracker = state.tracker;
+        self.stage.set_preprocessor(state.preprocessor);
+        Ok(())
     }
 
     /// Detects (or takes the detections of) one frame and tracks it, streaming: the points
@@ -348,7 +457,7 @@ impl Pipeline {
                 "a streamed run has a single pass; set it to 0 or run the whole sequence at once",
             ));
         }
-        self.step_output_pass(input, &mut CountingSink::new(sink), &mut |_, _| {})
+        self.step_output_pass(input, sink, &mut RunTally::default(), &mut |_, _| {})
     }
 
     /// Flushes the points the tracker still holds at the end of a streamed run
@@ -358,10 +467,11 @@ impl Pipeline {
     }
 
     /// One frame of the output pass: observe, then track.
-    fn step_output_pass(
+    fn step_output_pass<S: TrackSink + ?Sized>(
         &mut self,
         input: &FrameInput,
-        sink: &mut CountingSink<'_>,
+        sink: &mut S,
+        tally: &mut RunTally,
         on_frame: &mut FrameObserver<'_>,
     ) -> Result<FrameReport> {
         let detect = self.observe(input)?;
@@ -369,21 +479,23 @@ impl Pipeline {
             FrameInput::Image(frame) => Some(frame),
             FrameInput::Detections { .. } => None,
         };
-        self.track(input.index(), frame, detect, sink, on_frame)
+        self.track(input.index(), frame, detect, sink, tally, on_frame)
     }
 
     /// Feeds `self.detections` of frame `index` to the tracker, with the image the detector saw
     /// and its candidates when `frame` is at hand (not in replayed training passes), else the
-    /// candidates given with the detections; then shows the report to `on_frame`.
-    fn track(
+    /// candidates given with the detections; counts the frame and its points in `tally`, then
+    /// shows the report to `on_frame`.
+    fn track<S: TrackSink + ?Sized>(
         &mut self,
         index: FrameIndex,
         frame: Option<&Frame>,
         detect_time: Duration,
-        sink: &mut CountingSink<'_>,
+        sink: &mut S,
+        tally: &mut RunTally,
         on_frame: &mut FrameObserver<'_>,
     ) -> Result<FrameReport> {
-        let before = sink.points;
+        let before = tally.points;
         let start = Instant::now();
         let (image, candidates) = match frame {
             Some(frame) => (
@@ -398,12 +510,22 @@ impl Pipeline {
             image,
             candidates,
         };
-        self.tracker.as_tracker().step(&observations, sink)?;
+        let mut counting = CountingSink {
+            inner: &mut *sink,
+            tally: &mut *tally,
+        };
+        self.tracker
+            .as_tracker()
+            .step(&observations, &mut counting)?;
+        tally.frames += 1;
+        tally.last_frame = Some(index);
+        tally.detections += self.detections.len() as u64;
+        tally.candidates += candidates.len() as u64;
         let report = FrameReport {
             frame: index,
             detections: self.detections.len(),
             candidates: candidates.len(),
-            points_emitted: (sink.points - before) as usize,
+            points_emitted: (tally.points - before) as usize,
             detect_time,
             track_time: start.elapsed(),
         };

@@ -4,16 +4,18 @@
 
 use std::path::Path;
 
-use sillage_core::{Error, Result, TrackSink};
+use sillage_core::{Error, FrameIndex, Result, TrackSink};
 use sillage_io::{
-    FrameOptions, FrameSource, TrackFileHeader, TrackFormat, TrackWriter, WrittenSummary,
-    create_track_writer, open_frames, read_tractrac_par, write_in_background,
+    BadFramePolicy, FrameOptions, SkippedFrame, TrackFileHeader, TrackFormat, WrittenSummary,
+    create_track_writer, open_frames, read_tractrac_par,
 };
 
 use sillage_detect::blob::Calibration;
 
+use crate::checkpoint::RunIdentity;
 use crate::config::{DetectorConfig, PipelineConfig};
-use crate::pipeline::{FrameReport, Pipeline, RunSummary};
+use crate::long_run::{Inputs, LongRunOptions, LongRunOutput, run_long};
+use crate::pipeline::{FrameInput, FrameReport, Pipeline, RunSummary};
 use crate::toml_config::{Settings, dotted_keys, load_unvalidated, set_key};
 use crate::tractrac::apply_par;
 
@@ -77,12 +79,16 @@ pub fn track_header(
     })
 }
 
-/// A pipeline ready to track a frame source: built, its background primed, the frames open.
+/// A pipeline ready to track a frame source: built, its background primed, the scale of
+/// its particles measured.
 pub struct PtvRun {
     pipeline: Pipeline,
-    frames: FrameSource,
+    input: String,
+    config: PipelineConfig,
     header: TrackFileHeader,
     background_frames: Option<usize>,
+    frame_count: Option<usize>,
+    on_bad_frame: BadFramePolicy,
 }
 
 /// What [`PtvRun::run_to_file`] did.
@@ -92,6 +98,10 @@ pub struct PtvFileRun {
     pub summary: RunSummary,
     /// The file written and its rows.
     pub written: WrittenSummary,
+    /// The frames skipped (`--on-bad-frame skip`), in order.
+    pub skipped: Vec<SkippedFrame>,
+    /// The last frame of the checkpoint the run resumed from (`None`: from the start).
+    pub resumed_after: Option<FrameIndex>,
 }
 
 impl PtvRun {
@@ -99,24 +109,42 @@ impl PtvRun {
     /// video); with background subtraction, the model starts as the mean of the first frames
     /// (TracTrac's Eq. (2)), read from a first opening of the source.
     /// An `"auto"` blob scale or polarity is measured on the first frame here, so that the
-    /// header records it.
+    /// header records it. Bad frames stop the run ([`PtvRun::open_with`] to skip them).
     pub fn open(config: &PipelineConfig, input: &str) -> Result<Self> {
+        Self::open_with(config, input, BadFramePolicy::Stop)
+    }
+
+    /// [`PtvRun::open`] with frames that cannot be read handled by `on_bad_frame`.
+    pub fn open_with(
+        config: &PipelineConfig,
+        input: &str,
+        on_bad_frame: BadFramePolicy,
+    ) -> Result<Self> {
+        let options = FrameOptions {
+            on_bad_frame,
+            ..FrameOptions::default()
+        };
         let mut pipeline = Pipeline::from_config(config)?;
         let background_frames = if pipeline.background_init_frames() > 0 {
-            Some(pipeline.prime_background(open_frames(input, &FrameOptions::default())?)?)
+            Some(pipeline.prime_background(open_frames(input, &options)?)?)
         } else {
             None
         };
+        let mut probe = open_frames(input, &options)?;
+        let frame_count = probe.len();
         if let DetectorConfig::Blob(_) = config.detector
-            && let Some(first) = open_frames(input, &FrameOptions::default())?.next()
+            && let Some(first) = probe.next()
         {
             pipeline.calibrate(&first?)?;
         }
         Ok(Self {
             header: track_header(config, pipeline.calibration().as_ref())?,
             pipeline,
-            frames: open_frames(input, &FrameOptions::default())?,
+            input: input.to_string(),
+            config: config.clone(),
             background_frames,
+            frame_count,
+            on_bad_frame,
         })
     }
 
@@ -132,12 +160,21 @@ impl PtvRun {
 
     /// Number of frames to track, when the source knows it (not for every video).
     pub fn frame_count(&self) -> Option<usize> {
-        self.frames.len()
+        self.frame_count
     }
 
     /// The header of the track files of this run ([`track_header`]).
     pub fn header(&self) -> &TrackFileHeader {
         &self.header
+    }
+
+    /// The frame options of this run's source, from frame `start_at` on.
+    fn frame_options(&self, start_at: FrameIndex) -> FrameOptions {
+        FrameOptions {
+            on_bad_frame: self.on_bad_frame,
+            start_at,
+            ..FrameOptions::default()
+        }
     }
 
     /// Tracks every frame into `sink`; `on_frame` is called after each (progress bars).
@@ -146,7 +183,8 @@ impl PtvRun {
         sink: &mut dyn TrackSink,
         on_frame: &mut dyn FnMut(&FrameReport),
     ) -> Result<RunSummary> {
-        self.pipeline.run(self.frames, sink, on_frame)
+        let frames = open_frames(&self.input, &self.frame_options(0))?;
+        self.pipeline.run(frames, sink, on_frame)
     }
 
     /// Tracks every frame into the track file `out` in `format`. Rows written before an error
@@ -157,17 +195,65 @@ impl PtvRun {
         format: TrackFormat,
         on_frame: &mut dyn FnMut(&FrameReport),
     ) -> Result<PtvFileRun> {
-        // Rows are formatted and written on a thread of their own while tracking goes on.
-        let mut writer = Box::new(write_in_background(create_track_writer(
-            out,
-            format,
-            &self.header,
-        )?)?);
-        let outcome = self.run(writer.as_mut(), on_frame);
-        let written = writer.finish()?;
+        let options = LongRunOptions {
+            on_bad_frame: self.on_bad_frame,
+            ..LongRunOptions::default()
+        };
+        self.run_long(out, format, &options, on_frame)
+    }
+
+    /// [`PtvRun::run_to_file`] with checkpoints and resume (see [`crate::long_run`]);
+    /// `options.on_bad_frame` must be the policy the run was opened with.
+    pub fn run_long(
+        mut self,
+        out: &Path,
+        format: TrackFormat,
+        options: &LongRunOptions,
+        on_frame: &mut dyn FnMut(&FrameReport),
+    ) -> Result<PtvFileRun> {
+        if options.on_bad_frame != self.on_bad_frame {
+            return Err(Error::input(
+                "the bad-frame policy differs from the one the run was opened with",
+            ));
+        }
+        let mut settings = dotted_keys(&self.config)?;
+        settings.push(("format".to_string(), format.name().to_string()));
+        settings.extend(options.settings());
+        let identity = RunIdentity::new("ptv", &self.input, out, settings);
+        let header = self.header.clone();
+        let mut create_writer = || create_track_writer(out, format, &header);
+        let output = LongRunOutput {
+            path: out,
+            create_writer: &mut create_writer,
+            identity,
+        };
+        let (input, frame_options) = (self.input.clone(), self.frame_options(0));
+        let mut open_inputs = move |start_at: FrameIndex| -> Result<Inputs<'static>> {
+            let frames = open_frames(
+                &input,
+                &FrameOptions {
+                    start_at,
+                    ..frame_options.clone()
+                },
+            )?;
+            let log = frames.skipped();
+            Ok((
+                Box::new(frames.map(|f| f.map(FrameInput::Image))),
+                Some(log),
+            ))
+        };
+        let outcome = run_long(
+            &mut self.pipeline,
+            &mut open_inputs,
+            output,
+            options,
+            &mut |report, _| on_frame(report),
+        )?;
         Ok(PtvFileRun {
-            summary: outcome?,
-            written,
+            summary: outcome.summary,
+            written: outcome.written,
+            skipped: outcome.skipped,
+            resumed_after: outcome.resumed_after,
         })
     }
 }

@@ -84,7 +84,7 @@ impl BedloadMode {
 const SALTATING: usize = 2;
 
 /// The validated bedload motion model: Eq. (3) with jump-Markov switching.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BedloadModel {
     params: BedloadParams,
     /// Rows resting, rolling, saltating, unknown; columns resting, rolling, saltating.

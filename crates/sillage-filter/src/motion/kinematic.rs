@@ -46,7 +46,7 @@ pub(crate) fn constant_velocity(
 
 /// A validated kinematic model over `(x, y, u, v[, aₓ, a_y])`, one frame per step (T = 1):
 /// `X ← A_k·X + ν` with the matrices of Eqs. (10)-(12) of the IMM-PF paper.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum KinematicModel {
     /// Eq. (10): `x ← x + ε_x`; velocity and acceleration reduced to zero.
     ConstantPosition {

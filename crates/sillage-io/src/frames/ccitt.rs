@@ -65,8 +65,18 @@ pub(crate) fn decode_modified_huffman<R: Read + Seek>(
             counts.len()
         ));
     }
+    // The header's size is not trusted for an allocation: pixels are appended as rows are
+    // decoded (so memory follows the file's length), up to the limit the `tiff` crate puts
+    // on the decoded samples of the other compressions.
+    let limit = tiff::decoder::Limits::default().decoding_buffer_size as u64;
+    if u64::from(width) * u64::from(height) > limit {
+        return Err(format!(
+            "{width} × {height} pixels is more than the {limit} a frame may have; the file is \
+             damaged, or crop the image"
+        ));
+    }
     let (w, h) = (width as usize, height as usize);
-    let mut pixels = Vec::with_capacity(w * h);
+    let mut pixels = Vec::new();
     let mut strip = Vec::new();
     for (s, (&offset, &count)) in offsets.iter().zip(&counts).take(strips).enumerate() {
         read_strip(decoder.inner(), offset, count, &mut strip)
@@ -207,6 +217,55 @@ mod tests {
         out.clear();
         decode_rows(&data[4..], 8, 1, &mut out).unwrap();
         assert_eq!(out, [1, 1, 1, 0, 0, 0, 1, 1]);
+    }
+
+    /// A little-endian one-strip TIFF of `width` × `height` 1-bit pixels compressed with
+    /// modified Huffman, whose strip is `strip`.
+    fn mh_tiff(width: u32, height: u32, strip: &[u8]) -> Vec<u8> {
+        const ENTRIES: u16 = 8;
+        let strip_offset = 8 + 2 + 12 * u32::from(ENTRIES) + 4;
+        let mut bytes = b"II*\0".to_vec();
+        bytes.extend(8u32.to_le_bytes());
+        bytes.extend(ENTRIES.to_le_bytes());
+        // (tag, type 3 SHORT / 4 LONG, value), in increasing tag order.
+        for (tag, kind, value) in [
+            (256u16, 4u16, width),
+            (257, 4, height),
+            (258, 3, 1),
+            (259, 3, u32::from(MODIFIED_HUFFMAN)),
+            (262, 3, 0),
+            (273, 4, strip_offset),
+            (278, 4, height),
+            (279, 4, strip.len() as u32),
+        ] {
+            bytes.extend(tag.to_le_bytes());
+            bytes.extend(kind.to_le_bytes());
+            bytes.extend(1u32.to_le_bytes());
+            bytes.extend(value.to_le_bytes());
+        }
+        bytes.extend(0u32.to_le_bytes());
+        bytes.extend(strip);
+        bytes
+    }
+
+    #[test]
+    fn a_huge_size_in_the_header_is_refused_before_any_allocation() {
+        // 2³² − 1 pixels square: the size alone once sized the pixel buffer (capacity
+        // overflow); a fuzzed header of 10⁵ × 10⁵ reserved 10 GB.
+        for side in [u32::MAX, 100_000] {
+            let tiff = mh_tiff(side, side, &[0x35, 0x00]);
+            let error = crate::read_image_from_bytes(std::path::Path::new("mask.tif"), &tiff)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                error.contains("mask.tif") && error.contains("is more than the"),
+                "{error}"
+            );
+        }
+        // The same file at 8 × 1 px decodes (white 8 = 10011, then black 0 = 0000110111).
+        let tiff = mh_tiff(8, 1, &[0b1001_1000, 0b0110_1110]);
+        let image = crate::read_image_from_bytes(std::path::Path::new("mask.tif"), &tiff).unwrap();
+        assert_eq!(image.as_slice(), &[1.0; 8]);
     }
 
     #[test]

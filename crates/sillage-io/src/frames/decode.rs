@@ -11,6 +11,7 @@
 //! (`v / 257`), clamps float ones to `[0, 1]` before scaling by 255, and replicates grey
 //! into the three channels.
 
+use std::io::{BufRead, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use sillage_core::{GrayImage, LUMA_601, Result, RgbImage};
@@ -46,18 +47,70 @@ pub(crate) fn has_extension(path: &Path, extensions: &[&str]) -> bool {
 /// Decodes the image file at `path` (for a TIFF, its first page), with its colour when
 /// `colour` is true.
 pub(crate) fn decode_file(path: &Path, colour: bool) -> DecodeResult<Decoded> {
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    decode_reader(path, std::io::BufReader::new(file), colour)
+}
+
+/// Decodes the image that `reader` holds (for a TIFF, its first page), with its colour when
+/// `colour` is true. `path` names the source: a TIFF extension selects the TIFF decoder, any
+/// other is the format hint when the bytes do not tell it.
+fn decode_reader<R: BufRead + Seek>(path: &Path, reader: R, colour: bool) -> DecodeResult<Decoded> {
     if is_tiff(path) {
-        let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-        let mut decoder = Decoder::new(std::io::BufReader::new(file)).map_err(|e| e.to_string())?;
+        let mut decoder = Decoder::new(reader).map_err(|e| e.to_string())?;
         decode_tiff_page(&mut decoder, colour)
     } else {
-        let image = image::ImageReader::open(path)
-            .map_err(|e| e.to_string())?
+        let mut reader = reader;
+        check_png_palette(&mut reader)?;
+        let mut reader = image::ImageReader::new(reader);
+        if let Ok(format) = image::ImageFormat::from_path(path) {
+            reader.set_format(format);
+        }
+        let image = reader
             .with_guessed_format()
             .map_err(|e| e.to_string())?
             .decode()
             .map_err(|e| e.to_string())?;
         decode_dynamic(image, colour)
+    }
+}
+
+/// Refuses a PNG whose palette (`PLTE` chunk) is not a whole number of RGB entries, 1 to 256,
+/// which the `png` crate's palette expansion indexes past the end of (a panic) instead of
+/// reporting. Reads the chunk headers before the image data, then rewinds `reader`; bytes
+/// that are not a PNG, or a PNG cut short, are left to the decoder to report.
+fn check_png_palette<R: Read + Seek>(reader: &mut R) -> DecodeResult<()> {
+    let start = reader.stream_position().map_err(|e| e.to_string())?;
+    let palette = png_palette_length(reader);
+    reader
+        .seek(SeekFrom::Start(start))
+        .map_err(|e| e.to_string())?;
+    match palette {
+        Ok(Some(length)) if length == 0 || length > 3 * 256 || length % 3 != 0 => Err(format!(
+            "PNG palette (PLTE chunk) of {length} bytes; a palette is 1 to 256 RGB entries of \
+             3 bytes each, so the file is damaged"
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The length of the `PLTE` chunk of the PNG `reader` is at, `None` when there is none before
+/// the image data or the bytes are not a PNG.
+fn png_palette_length<R: Read + Seek>(reader: &mut R) -> std::io::Result<Option<u32>> {
+    let mut signature = [0u8; 8];
+    reader.read_exact(&mut signature)?;
+    if signature != *b"\x89PNG\r\n\x1a\n" {
+        return Ok(None);
+    }
+    loop {
+        // Each chunk: length (big-endian u32), type, data, CRC (4 bytes).
+        let mut header = [0u8; 8];
+        reader.read_exact(&mut header)?;
+        let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]);
+        match &header[4..] {
+            b"PLTE" => return Ok(Some(length)),
+            b"IDAT" | b"IEND" => return Ok(None),
+            _ => reader.seek(SeekFrom::Current(i64::from(length) + 4))?,
+        };
     }
 }
 
@@ -241,20 +294,70 @@ pub fn read_image(path: impl AsRef<Path>) -> Result<GrayImage> {
     super::input::check_exists(path)?;
     decode_file(path, false)
         .map(|decoded| decoded.grey)
-        .map_err(|message| {
-            sillage_core::Error::format(
-                path,
-                None,
-                format!(
-                    "cannot decode: {message}; check that it is a valid PNG, JPEG or TIFF image"
-                ),
-            )
-        })
+        .map_err(|message| decode_error(path, &message))
+}
+
+/// Decodes one image held in `bytes` as [`read_image`] decodes a file: `path` names it in
+/// errors, and its extension tells a TIFF (`.tif`, `.tiff`, first page decoded) from PNG and
+/// JPEG, whose format is read from the bytes.
+pub fn read_image_from_bytes(path: &Path, bytes: &[u8]) -> Result<GrayImage> {
+    decode_reader(path, std::io::Cursor::new(bytes), false)
+        .map(|decoded| decoded.grey)
+        .map_err(|message| decode_error(path, &message))
+}
+
+fn decode_error(path: &Path, message: &str) -> sillage_core::Error {
+    sillage_core::Error::format(
+        path,
+        None,
+        format!("cannot decode: {message}; check that it is a valid PNG, JPEG or TIFF image"),
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 1 × 1 indexed PNG with the `PLTE` chunk `plte` (length, type, data and CRC).
+    fn indexed_png(plte: &[u8]) -> Vec<u8> {
+        let signature_and_header = [
+            0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48,
+            0x44, 0x52, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x08, 0x03, 0x00, 0x00,
+            0x00, 0x28, 0xcb, 0x34, 0xbb,
+        ];
+        // IDAT (zlib of the row: filter 0, index 0), then IEND.
+        let data_and_end = [
+            0x00, 0x00, 0x00, 0x0a, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0x60, 0x00, 0x00,
+            0x00, 0x02, 0x00, 0x01, 0x48, 0xaf, 0xa4, 0x71, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45,
+            0x4e, 0x44, 0xae, 0x42, 0x60, 0x82,
+        ];
+        [&signature_and_header[..], plte, &data_and_end].concat()
+    }
+
+    #[test]
+    fn a_png_palette_of_a_partial_entry_is_an_error_not_a_panic() {
+        // Found by `cargo fuzz run frame_decode` (docs/fuzzing.md): a 4-byte PLTE chunk made
+        // the png crate's palette expansion panic (range end index 3 out of range).
+        let partial = indexed_png(&[
+            0x00, 0x00, 0x00, 0x04, 0x50, 0x4c, 0x54, 0x45, 0x33, 0x66, 0x99, 0x01, 0xcd, 0xe3,
+            0x4f, 0x62,
+        ]);
+        let error = read_image_from_bytes(Path::new("mask.png"), &partial)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("mask.png") && error.contains("(PLTE chunk) of 4 bytes"),
+            "{error}"
+        );
+        // One whole entry (0x33, 0x66, 0x99) decodes.
+        let whole = indexed_png(&[
+            0x00, 0x00, 0x00, 0x03, 0x50, 0x4c, 0x54, 0x45, 0x33, 0x66, 0x99, 0x3b, 0x23, 0x81,
+            0xd2,
+        ]);
+        let image = read_image_from_bytes(Path::new("mask.png"), &whole).unwrap();
+        let luma = LUMA_601[0] * 0.2 + LUMA_601[1] * 0.4 + LUMA_601[2] * 0.6;
+        assert!((image.get(0, 0) - luma).abs() < 1e-6, "{}", image.get(0, 0));
+    }
 
     #[test]
     fn colour_becomes_rec601_luma_and_alpha_is_dropped() {

@@ -2,6 +2,7 @@
 //! videos (through the `ffmpeg` program), decoded on a background thread with a bounded
 //! read-ahead queue so memory stays bounded whatever the length of the sequence.
 
+mod bad_frames;
 mod ccitt;
 mod decode;
 mod encode;
@@ -16,7 +17,8 @@ use std::thread::JoinHandle;
 use crossbeam_channel::{Receiver, Sender};
 use sillage_core::{Error, FrameIndex, GrayImage, Result, RgbImage};
 
-pub use decode::read_image;
+pub use bad_frames::{BadFramePolicy, SkippedFrame, SkippedFrames};
+pub use decode::{read_image, read_image_from_bytes};
 pub use encode::{write_png_rgb, write_png16, write_text};
 pub use mp4::Mp4Writer;
 
@@ -38,6 +40,12 @@ pub struct FrameOptions {
     /// Also decode each frame's 8-bit colour into [`Frame::colour`] (for colour-histogram
     /// observation models); default false, so grey-only pipelines pay nothing for it.
     pub colour: bool,
+    /// What to do with a frame that cannot be read or is missing from a numbered sequence
+    /// (see [`BadFramePolicy`]); default: stop.
+    pub on_bad_frame: BadFramePolicy,
+    /// Frames of a lower index are passed over (a resumed run): files are not even decoded,
+    /// pages and video frames are decoded and dropped. Default 0.
+    pub start_at: FrameIndex,
 }
 
 impl Default for FrameOptions {
@@ -48,6 +56,8 @@ impl Default for FrameOptions {
             ffmpeg: "ffmpeg".into(),
             ffprobe: "ffprobe".into(),
             colour: false,
+            on_bad_frame: BadFramePolicy::Stop,
+            start_at: 0,
         }
     }
 }
@@ -77,6 +87,7 @@ pub struct FrameSource {
     len: Option<usize>,
     dimensions: (usize, usize),
     paths: Vec<PathBuf>,
+    skipped: SkippedFrames,
     ended: bool,
 }
 
@@ -92,21 +103,39 @@ pub struct FrameSource {
 /// With [`FrameOptions::colour`] each frame also carries its 8-bit colour; a video is then
 /// decoded as RGB and its grey derived with the same Rec. 601 weights.
 ///
+/// A frame's index is its position in the sequence; in a folder or glob whose names are
+/// numbered (`img_0001.tif` …), the frame number's offset from the first one's, so that a
+/// frame missing from the numbering is a gap: an error with [`BadFramePolicy::Stop`], a
+/// skipped index with [`BadFramePolicy::Skip`], which also goes on past frames that do not
+/// decode or have the wrong size ([`FrameSource::skipped`] lists them).
+///
 /// The first frame's size is read here, so a missing or unreadable input fails now rather
 /// than on the first iteration.
 pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
     let limit = |n: usize| options.max_frames.map_or(n, |m| m.min(n));
     let colour = options.colour;
+    let skipped = SkippedFrames::default();
     let (sender, receiver) = crossbeam_channel::bounded(options.read_ahead);
+    let reading = Reading {
+        sender,
+        max_frames: options.max_frames,
+        policy: options.on_bad_frame,
+        skipped: skipped.clone(),
+        start_at: options.start_at,
+    };
     let (len, dimensions, paths, worker) = match input::resolve(input)? {
         InputKind::Files(mut files) => {
             let first = &files[0];
             let dimensions = decode::file_dimensions(first)
                 .map_err(|message| Error::frame(first, 0, decode_failure(&message)))?;
-            let len = limit(files.len());
-            files.truncate(len);
+            files.truncate(limit(files.len()));
+            let mut indices = bad_frames::indices_under(&files, options.on_bad_frame, &skipped)?;
+            let passed_over = indices.partition_point(|&i| i < options.start_at);
+            files.drain(..passed_over);
+            indices.drain(..passed_over);
+            let len = files.len();
             let worker_files = files.clone();
-            let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
+            let worker = spawn(reading, dimensions, Some(indices), move |emitter| {
                 read_files(&worker_files, colour, emitter);
             })?;
             (Some(len), dimensions, files, worker)
@@ -115,7 +144,7 @@ pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
             let dimensions = decode::file_dimensions(&path)
                 .map_err(|message| Error::frame(&path, 0, decode_failure(&message)))?;
             let stack = path.clone();
-            let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
+            let worker = spawn(reading, dimensions, None, move |emitter| {
                 tiff_stack::read_pages(&stack, colour, |page| match page {
                     Ok(image) => emitter.frame(&stack, image),
                     Err(message) => emitter.fail(&stack, decode_failure(&message)),
@@ -128,7 +157,7 @@ pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
             let decoder = FfmpegDecoder::spawn(&options.ffmpeg, &path, colour)?;
             let video = path.clone();
             let dimensions = (info.width, info.height);
-            let worker = spawn(sender, dimensions, options.max_frames, move |emitter| {
+            let worker = spawn(reading, dimensions, None, move |emitter| {
                 read_video(decoder, info, &video, emitter);
             })?;
             (info.frames.map(limit), dimensions, vec![path], worker)
@@ -140,6 +169,7 @@ pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
         len,
         dimensions,
         paths,
+        skipped,
         ended: false,
     })
 }
@@ -193,21 +223,32 @@ fn read_video(decoder: FfmpegDecoder, info: VideoInfo, path: &Path, emitter: &mu
     });
 }
 
-/// Starts the reading thread, which runs `read` with an [`Emitter`] on `sender`.
-fn spawn(
+/// How the reading thread hands frames over: the queue, the frame limit, and what to do with
+/// bad frames.
+struct Reading {
     sender: Sender<Result<Frame>>,
-    dimensions: (usize, usize),
     max_frames: Option<usize>,
+    policy: BadFramePolicy,
+    skipped: SkippedFrames,
+    start_at: FrameIndex,
+}
+
+/// Starts the reading thread, which runs `read` with an [`Emitter`]; `indices` are the frame
+/// indices of the files read in order (`None`: positions).
+fn spawn(
+    reading: Reading,
+    dimensions: (usize, usize),
+    indices: Option<Vec<FrameIndex>>,
     read: impl FnOnce(&mut Emitter) + Send + 'static,
 ) -> Result<JoinHandle<()>> {
     std::thread::Builder::new()
         .name("sillage-frames".into())
         .spawn(move || {
             let mut emitter = Emitter {
-                sender,
+                reading,
                 dimensions,
-                max_frames,
-                next_index: 0,
+                indices,
+                position: 0,
             };
             read(&mut emitter);
         })
@@ -217,22 +258,40 @@ fn spawn(
 /// The reading thread's end of the queue: numbers frames, checks their size, and tells the
 /// reader when to stop (consumer gone, frame limit reached, or an error sent).
 struct Emitter {
-    sender: Sender<Result<Frame>>,
+    reading: Reading,
     dimensions: (usize, usize),
-    max_frames: Option<usize>,
-    next_index: FrameIndex,
+    indices: Option<Vec<FrameIndex>>,
+    /// Frames read so far, good or bad.
+    position: usize,
 }
 
 impl Emitter {
+    /// The index of the frame at the current position.
+    fn index(&self) -> FrameIndex {
+        self.indices
+            .as_ref()
+            .and_then(|indices| indices.get(self.position).copied())
+            .unwrap_or(self.position as FrameIndex)
+    }
+
+    /// Whether the position is past the frame limit.
+    fn past_limit(&self) -> bool {
+        self.reading.max_frames.is_some_and(|m| self.position >= m)
+    }
+
     /// Sends one decoded frame; `false` means stop reading.
     fn frame(&mut self, path: &Path, decoded: Decoded) -> bool {
         let Decoded {
             grey: image,
             colour,
         } = decoded;
-        let index = self.next_index;
-        if self.max_frames.is_some_and(|m| index >= m as FrameIndex) {
+        if self.past_limit() {
             return false;
+        }
+        let index = self.index();
+        if index < self.reading.start_at {
+            self.position += 1;
+            return true;
         }
         if image.dimensions() != self.dimensions {
             let (w0, h0) = self.dimensions;
@@ -251,20 +310,33 @@ impl Emitter {
             image,
             colour,
         };
-        self.next_index += 1;
-        let below_limit = self
-            .max_frames
-            .is_none_or(|m| self.next_index < m as FrameIndex);
-        self.sender.send(Ok(frame)).is_ok() && below_limit
+        self.position += 1;
+        self.reading.sender.send(Ok(frame)).is_ok() && !self.past_limit()
     }
 
-    /// Sends the error of the current frame; always `false` (stop reading).
+    /// The current frame is bad: with [`BadFramePolicy::Stop`] sends its error and returns
+    /// `false` (stop reading); with [`BadFramePolicy::Skip`] records it and goes on.
     fn fail(&mut self, path: &Path, message: String) -> bool {
-        // If the consumer is gone nobody needs the error.
-        let _ = self
-            .sender
-            .send(Err(Error::frame(path, self.next_index, message)));
-        false
+        let index = self.index();
+        match self.reading.policy {
+            BadFramePolicy::Stop => {
+                // If the consumer is gone nobody needs the error.
+                let _ = self
+                    .reading
+                    .sender
+                    .send(Err(Error::frame(path, index, message)));
+                false
+            }
+            BadFramePolicy::Skip => {
+                self.reading.skipped.push(SkippedFrame {
+                    index,
+                    path: path.to_path_buf(),
+                    reason: message,
+                });
+                self.position += 1;
+                !self.past_limit()
+            }
+        }
     }
 }
 
@@ -287,6 +359,12 @@ impl FrameSource {
     /// The files read, in order: every image of a folder or glob, or the one stack or video.
     pub fn paths(&self) -> &[PathBuf] {
         &self.paths
+    }
+
+    /// The frames skipped under [`BadFramePolicy::Skip`]: a handle that stays readable after
+    /// the source is consumed.
+    pub fn skipped(&self) -> SkippedFrames {
+        self.skipped.clone()
     }
 }
 

@@ -10,7 +10,7 @@ use sillage_core::{Detection, ObjectClass, Point2};
 use crate::bedload::params::AssociationParams;
 
 /// A tracker as the association sees it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Query {
     /// Predicted position x̂, px.
     pub pred_px: Point2,
@@ -22,7 +22,7 @@ pub(crate) struct Query {
 }
 
 /// One candidate pair.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 struct Pair {
     cost: f64,
     tracker: u32,
@@ -30,7 +30,7 @@ struct Pair {
 }
 
 /// The association of one frame (buffers reused frame to frame).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub(crate) struct GreedyAssociation {
     index: PointIndex,
     positions: Vec<Point2>,

@@ -15,7 +15,7 @@ use crate::bedload::params::{ConfidenceSet, LikelihoodParams};
 const SAME_CANDIDATE_PX: f64 = 1.0;
 
 /// The candidates of one class in one frame.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 struct ClassDensity {
     positions: Vec<Point2>,
     likelihoods: Vec<f64>,
@@ -23,7 +23,7 @@ struct ClassDensity {
 }
 
 /// The density of every class for one frame (buffers reused frame to frame).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub(crate) struct ConfidenceDensity {
     classes: Vec<ClassDensity>,
     claimed: PointIndex,

@@ -6,7 +6,7 @@ use sillage_assoc::PointIndex;
 use sillage_core::{MotionState, ObjectClass, Point2};
 
 /// The thresholds of Eq. (4), in px/frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(crate) struct StateRule {
     /// nbN_rest.
     pub neighbours_rest: u32,
@@ -35,7 +35,7 @@ impl StateRule {
 }
 
 /// The beads of one frame, indexed for contact counts (buffers reused frame to frame).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Contacts {
     positions: Vec<Point2>,
     classes: Vec<ObjectClass>,

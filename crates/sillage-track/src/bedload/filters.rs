@@ -8,7 +8,7 @@ use crate::bedload::params::{BedloadTrackerKind, Settings};
 use crate::bedload::particle::{self, ParticleMotion, Weighting};
 
 /// What a tracker observes in the current frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(crate) enum Observation {
     /// A detection was associated: its position `x_obs`, the observed velocity `u_obs` and
     /// the motion state `s_obs` measured by Eq. (4).
@@ -25,7 +25,7 @@ pub(crate) enum Observation {
 }
 
 /// A tracker's estimate after one frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Estimate {
     /// Position, px.
     pub pos_px: Point2,
@@ -36,7 +36,7 @@ pub(crate) struct Estimate {
 }
 
 /// One tracker's estimator.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(crate) enum TrackFilter {
     /// MMPF+, MMPF, PF.
     Particles(Box<ParticleFilter>),

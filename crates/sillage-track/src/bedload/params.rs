@@ -274,7 +274,7 @@ impl Default for BedloadTrackerParams {
 }
 
 /// Validated parameters in px and px/frame, ready for the trackers.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Settings {
     pub kind: BedloadTrackerKind,
     pub radius_px: Vec<f64>,

@@ -12,7 +12,7 @@ use crate::bedload::confidence::ConfidenceDensity;
 use crate::bedload::filters::{Estimate, Observation};
 
 /// The motion model of a particle tracker.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(crate) enum ParticleMotion {
     /// MMPF+ and MMPF: the bedload motions of Eq. (3) with jump-Markov switching.
     Switching(Box<BedloadModel>),

@@ -135,7 +135,7 @@ pub const MAX_LAG: u32 = 1000;
 pub(crate) type Evidence = Option<[f64; 3]>;
 
 /// The validated smoother, features in px and px/frame.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Smoother {
     lag: usize,
     transition: [[f64; 3]; 3],
@@ -244,7 +244,7 @@ impl SmootherParams {
 }
 
 /// A point waiting for its state, with its forward message.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Pending {
     point: TrackPoint,
     /// The evidence as likelihoods scaled to a largest of 1; `None` for no evidence.
@@ -254,7 +254,7 @@ struct Pending {
 }
 
 /// The points of one trajectory whose states are not final yet.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub(crate) struct StateChain {
     pending: VecDeque<Pending>,
     /// The forward message of the last point pushed.

@@ -20,7 +20,7 @@ use crate::bedload::particle::{ParticleMotion, Weighting};
 use crate::bedload::smoother::{CONTACT_RATIO_CAP, Evidence, Smoother, StateChain};
 
 /// Counts over a run, for reports and tests.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct BedloadStats {
     /// Frames stepped through (frames absent from the input included).
     pub frames: u64,
@@ -35,7 +35,7 @@ pub struct BedloadStats {
 }
 
 /// One tracker (a candidate trajectory until a second detection confirms it).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Track {
     /// Output id, given on confirmation.
     track_id: Option<TrackId>,
@@ -72,7 +72,7 @@ struct Track {
 /// With a smoother (`smoother.lag` > 0) a point is emitted `lag` frames later, when its state
 /// is final, and the rest at the end of its trajectory or at [`Tracker::finish`]. The output
 /// is identical for any number of threads.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BedloadTracker {
     settings: Settings,
     motion: ParticleMotion,

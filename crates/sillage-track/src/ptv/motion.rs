@@ -11,7 +11,7 @@ const PAR_MIN_SLOTS: usize = 4096;
 const UNKNOWN_LOG_ERR: f64 = 2.0;
 
 /// Velocity samples of the flow: where, which velocity, and how well it was predicted.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Samples {
     pub pos: Vec<Point2>,
     pub vel: Vec<Vec2>,
@@ -37,7 +37,7 @@ impl Samples {
 }
 
 /// One sample as the model averages it.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 struct Weighted {
     weight: f64,
     vel: Vec2,
@@ -50,7 +50,7 @@ struct Weighted {
 type Copies = [Weighted; 2];
 
 /// Evaluates the motion model at query points, reusing its index and buffers.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(crate) struct MotionField {
     k: usize,
     stored_weight: f64,

@@ -38,7 +38,7 @@ const VOTE_MIN_CORRECTION_SPACINGS: f64 = 0.0625;
 const PAR_MIN_LEN: usize = 1024;
 
 /// Direction of a pass over the sequence (TracTrac's `vid_loop` alternates them).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum PassDirection {
     /// Frames arrive in increasing order; time step `+dt`.
     #[default]
@@ -48,8 +48,26 @@ pub enum PassDirection {
     Backward,
 }
 
-/// One point of frame t−1 linked backwards and forwards: a candidate tracklet.
+/// The time steps of a triplet t−2 → t−1 → t: one frame each, more across missing frames.
 #[derive(Debug, Clone, Copy)]
+struct Steps {
+    /// Frames from t−2 to t−1.
+    before: u64,
+    /// Frames from t−1 to t.
+    after: u64,
+    /// The signed time step of one frame.
+    dt: f64,
+}
+
+impl Steps {
+    /// Whether a frame is missing within the triplet.
+    fn spans_gap(self) -> bool {
+        self.before > 1 || self.after > 1
+    }
+}
+
+/// One point of frame t−1 linked backwards and forwards: a candidate tracklet.
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 struct Triplet {
     /// Index in frame t−2.
     before: usize,
@@ -81,7 +99,7 @@ struct Triplet {
 /// Deterministic: no random tie-break (nearest-neighbour ties go to the lower index), and
 /// parallel work is per point with sequential reductions, so the output is the same bit for
 /// bit whatever the number of rayon threads.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct PtvTracker {
     params: PtvParams,
     direction: PassDirection,
@@ -89,6 +107,8 @@ pub struct PtvTracker {
     frames_in_pass: u8,
     /// Frame index of `c1`.
     frame_c1: FrameIndex,
+    /// Frames from `c0` to `c1`: 1, or more across frames missing from the sequence.
+    gap_c1: u64,
     // Positions of frames t−2, t−1 and t, and raw indexes of t−1 and t.
     c0: Vec<Point2>,
     c1: Vec<Point2>,
@@ -147,6 +167,7 @@ impl PtvTracker {
             direction: PassDirection::Forward,
             frames_in_pass: 0,
             frame_c1: 0,
+            gap_c1: 1,
             c0: Vec::new(),
             c1: Vec::new(),
             c2: Vec::new(),
@@ -443,11 +464,19 @@ impl PtvTracker {
     }
 
     /// Builds the triplets t−2 ↔ t−1 ↔ t, their kinematics and errors, applies the outlier
-    /// test and updates the threshold; the kept ones become `current`.
-    fn make_tracklets(&mut self, dt: f64) {
+    /// test and updates the threshold; the kept ones become `current`. Prediction errors are
+    /// measured over one frame's `dt`. Across a missing frame the model predicts from older
+    /// samples, so its errors are not comparable: the outlier test is not applied there and
+    /// the threshold is left as it was (mutual nearest neighbours still decide the links).
+    fn make_tracklets(&mut self, steps: Steps) {
         let (c0, c1, c2) = (&self.c0, &self.c1, &self.c2);
         let (vel_pred, log_err_pred) = (&self.vel_pred, &self.log_err_pred);
-        let (filter, threshold) = (self.params.filter, self.threshold);
+        let (filter, threshold) = (self.params.filter && !steps.spans_gap(), self.threshold);
+        let (dt_before, dt_after, dt) = (
+            steps.dt * steps.before as f64,
+            steps.dt * steps.after as f64,
+            steps.dt,
+        );
         // The linked triplets in middle-point order, then their kinematics in parallel, in
         // place (the log10 dominates; collecting filtered results in parallel cost twice as
         // much in allocations and copies).
@@ -471,14 +500,19 @@ impl PtvTracker {
             .with_min_len(PAR_MIN_LEN)
             .for_each(|t| {
                 let (x0, x1, x2) = (c0[t.before], c1[t.middle], c2[t.after]);
-                let u0 = (x1 - x0) / dt;
-                let u1 = (x2 - x1) / dt;
+                let u0 = (x1 - x0) / dt_before;
+                let u1 = (x2 - x1) / dt_after;
                 // Eq. (6): v(t−1) = (x(t) − x(t−2)) / 2Δt, the mean of the two finite
-                // differences.
-                t.vel = (u0 + u1) * 0.5;
+                // differences; across a missing frame, the three-point derivative for unequal
+                // steps (each difference weighted by the other step).
+                t.vel = if dt_before == dt_after {
+                    (u0 + u1) * 0.5
+                } else {
+                    (u0 * dt_after + u1 * dt_before) / (dt_before + dt_after)
+                };
                 // Eq. (7), whose signs were lost in the text:
-                // a(t−1) = (x(t) − 2x(t−1) + x(t−2)) / Δt².
-                t.acc = (u1 - u0) / dt;
+                // a(t−1) = (x(t) − 2x(t−1) + x(t−2)) / Δt² (the mean step for unequal ones).
+                t.acc = (u1 - u0) / (0.5 * (dt_before + dt_after));
                 t.log_err = log10_error(vel_pred[t.middle], t.vel, dt);
                 // §3.1.3: outlier when ε − ε̄ ≥ threshold (the threshold stands for
                 // n_σ·σ̄_ε).
@@ -490,12 +524,14 @@ impl PtvTracker {
         for t in self.triplets.iter().filter(|t| t.kept) {
             self.current.push(c1[t.middle], t.vel, t.log_err);
         }
-        self.threshold = updated_threshold(
-            self.threshold,
-            &self.errors,
-            self.params.filter_std,
-            self.params.filter_time,
-        );
+        if !steps.spans_gap() {
+            self.threshold = updated_threshold(
+                self.threshold,
+                &self.errors,
+                self.params.filter_std,
+                self.params.filter_time,
+            );
+        }
     }
 
     /// §3.1.4: each tracklet takes the id of its t−2 ↔ t−1 link; kept tracklets without one
@@ -544,8 +580,10 @@ impl PtvTracker {
         }
     }
 
-    /// Frame t becomes t−1: rotates positions, indexes, links and ids.
-    fn shift(&mut self, frame: FrameIndex) {
+    /// Frame t (`gap` frames after t−1) becomes t−1: rotates positions, indexes, links and
+    /// ids.
+    fn shift(&mut self, frame: FrameIndex, gap: u64) {
+        self.gap_c1 = gap;
         std::mem::swap(&mut self.c0, &mut self.c1);
         std::mem::swap(&mut self.c1, &mut self.c2);
         std::mem::swap(&mut self.index_c1, &mut self.index_c2);
@@ -613,6 +651,10 @@ impl Tracker for PtvTracker {
     fn step(&mut self, obs: &FrameObservations<'_>, sink: &mut dyn TrackSink) -> Result<()> {
         self.load_frame(obs)?;
         let dt = self.signed_dt();
+        // Frames missing from the sequence (skipped bad frames) lengthen the link to this one:
+        // predictions reach over the gap and the kinematics use the true time steps.
+        let gap = obs.frame.abs_diff(self.frame_c1).max(1);
+        let dt_link = dt * gap as f64;
         match self.frames_in_pass {
             0 => {
                 std::mem::swap(&mut self.c1, &mut self.c2);
@@ -623,11 +665,11 @@ impl Tracker for PtvTracker {
                 // First link of the pass (TracTrac's initialisation): frame 0 ↔ frame 1,
                 // predicted with whatever model earlier passes learned, which stays stored.
                 let applied = self.index_frame_and_model();
-                self.predict(applied, dt);
+                self.predict(applied, dt_link);
                 self.associate(applied);
                 self.ids1.clear();
                 self.ids1.resize(self.c1.len(), None);
-                self.shift(obs.frame);
+                self.shift(obs.frame, gap);
             }
             _ => {
                 let mut applied = self.index_frame_and_model();
@@ -640,17 +682,21 @@ impl Tracker for PtvTracker {
                             self.field.prepare(&self.current, &self.stored);
                         }
                     }
-                    self.predict(applied, dt);
+                    self.predict(applied, dt_link);
                     model_updated |= applied;
                     self.associate(applied);
-                    self.make_tracklets(dt);
+                    self.make_tracklets(Steps {
+                        before: self.gap_c1,
+                        after: gap,
+                        dt,
+                    });
                 }
                 if model_updated {
                     std::mem::swap(&mut self.stored, &mut self.next_stored);
                 }
                 self.hand_over_ids(sink)?;
                 std::mem::swap(&mut self.recent, &mut self.current);
-                self.shift(obs.frame);
+                self.shift(obs.frame, gap);
             }
         }
         self.frames_in_pass = (self.frames_in_pass + 1).min(2);

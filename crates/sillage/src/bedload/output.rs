@@ -54,7 +54,7 @@ pub enum BeadTrackOutput {
     /// BeadTracking's layout.
     Beads(BeadCsvWriter),
     /// A track table with [`TrackLayout::WithStates`], and its format.
-    Table(Box<dyn TrackWriter>, TrackFormat),
+    Table(Box<dyn TrackWriter + Send>, TrackFormat),
 }
 
 impl BeadTrackOutput {
@@ -105,5 +105,11 @@ impl TrackSink for BeadTrackOutput {
             Self::Beads(writer) => writer.accept(points),
             Self::Table(writer, _) => writer.accept(points),
         }
+    }
+}
+
+impl TrackWriter for BeadTrackOutput {
+    fn finish(self: Box<Self>) -> Result<WrittenSummary> {
+        BeadTrackOutput::finish(*self)
     }
 }

@@ -98,9 +98,10 @@ fn answer(
     write_response(&mut writer, &response)
 }
 
-/// The request on `stream`; `Ok(None)` when the client closed without sending one, `Err` with
-/// the 4xx answer when it is malformed or too large.
-fn read_request(stream: &TcpStream) -> Result<Option<Request>, Response> {
+/// Reads one request from `stream` (a connection, or any bytes): `Ok(None)` when the client
+/// closed without sending one, `Err` with the 4xx answer when it is malformed or too large.
+/// At most the head limit plus the body limit is read, whatever the stream holds.
+pub fn read_request(stream: impl Read) -> Result<Option<Request>, Response> {
     let mut head = BufReader::new(stream.take(MAX_HEAD_BYTES));
     let mut line = String::new();
     match head.read_line(&mut line) {
