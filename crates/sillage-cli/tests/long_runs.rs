@@ -210,6 +210,31 @@ fn a_checkpoint_of_other_settings_is_refused_by_name() {
         "{}",
         stderr(&output)
     );
+    // A fresh run over the killed one's files starts again: killed before its own first
+    // checkpoint (frame 50), it must not leave the old checkpoint to be resumed with its new
+    // spool.
+    assert!(read_checkpoint(&checkpoint_path(&out)).is_ok());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sillage"))
+        .args([
+            "ptv",
+            &seq,
+            "--out",
+            path_str(&out),
+            "--checkpoint-every",
+            "50",
+        ])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while checkpoint_path(&out).exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    // Gone while the run is still going: removed at its start, not at its end.
+    assert!(child.try_wait().unwrap().is_none(), "the run ended first");
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!checkpoint_path(&out).exists());
 }
 
 /// `(frame, x bits, y bits) → track id` of a CSV track table.

@@ -148,11 +148,18 @@ pub fn run_long(
                 saved.skipped,
             )
         }
-        None => (
-            SpoolWriter::create(&spool_file)?,
-            RunTally::default(),
-            Vec::new(),
-        ),
+        None => {
+            // A fresh run: an older checkpoint of this output would not match its new spool.
+            if checkpoint_file.exists() {
+                std::fs::remove_file(&checkpoint_file)
+                    .map_err(|e| Error::io(&checkpoint_file, e))?;
+            }
+            (
+                SpoolWriter::create(&spool_file)?,
+                RunTally::default(),
+                Vec::new(),
+            )
+        }
     };
     let resumed_after = tally.last_frame;
     let start_at = resumed_after.map_or(0, |f| f + 1);
