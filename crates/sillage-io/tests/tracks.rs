@@ -456,3 +456,24 @@ fn csv_state_errors_name_the_line_and_the_fix() {
         "{error}"
     );
 }
+
+/// The three damaged files on which the `parquet_tracks` fuzz target found `parquet` 60.1.0
+/// panicking (a negative column-chunk start in the footer, definition levels shorter than a
+/// page's values, a dictionary-encoded page without its dictionary): each is now an error
+/// naming the file.
+#[cfg(feature = "parquet")]
+#[test]
+fn damaged_parquet_files_found_by_fuzzing_are_errors_not_panics() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz");
+    for name in [
+        "parquet_negative_column_start.parquet",
+        "parquet_short_definition_levels.parquet",
+        "parquet_dictionary_missing.parquet",
+    ] {
+        let path = data.join(name);
+        let err = read_tracks(&path, TrackFormat::Parquet)
+            .expect_err(name)
+            .to_string();
+        assert!(err.contains(name) && err.contains("Parquet"), "{err}");
+    }
+}

@@ -16,7 +16,7 @@ use arrow_schema::{DataType, Field, Schema, SchemaRef};
 use parquet::arrow::ArrowWriter;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use parquet::basic::{Compression, ZstdLevel};
-use parquet::file::metadata::KeyValue;
+use parquet::file::metadata::{KeyValue, ParquetMetaData};
 use parquet::file::properties::WriterProperties;
 use sillage_core::{Error, MotionState, Result, TrackPoint, TrackSink};
 
@@ -46,6 +46,46 @@ fn schema(layout: TrackLayout) -> SchemaRef {
 
 fn parquet_error(path: &Path, action: &str, error: impl std::fmt::Display) -> Error {
     Error::format(path, None, format!("cannot {action} Parquet: {error}"))
+}
+
+/// Runs a step of the `parquet` decoder on the file at `path`, turning its errors and its
+/// panics into an error naming the file. `parquet` 60 asserts on some damaged files instead
+/// of returning an error (found by the `parquet_tracks` fuzz target: definition levels
+/// shorter than a page's values, a dictionary page missing); a user's damaged file must not
+/// crash the program.
+fn without_panics<T>(path: &Path, step: impl FnOnce() -> Result<T>) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(step)).unwrap_or_else(|_| {
+        Err(Error::format(
+            path,
+            None,
+            "cannot read Parquet: the file is damaged (its pages do not decode); write it again",
+        ))
+    })
+}
+
+/// Refuses a footer whose column chunks start or span a negative number of bytes (`parquet`
+/// asserts on them when it reads the pages).
+fn check_column_chunks(path: &Path, metadata: &ParquetMetaData) -> Result<()> {
+    for (g, group) in metadata.row_groups().iter().enumerate() {
+        for column in group.columns() {
+            let start = column
+                .dictionary_page_offset()
+                .unwrap_or(column.data_page_offset());
+            if start < 0 || column.compressed_size() < 0 {
+                return Err(Error::format(
+                    path,
+                    None,
+                    format!(
+                        "cannot read Parquet: row group {g}, column `{}` starts at byte {start} \
+                         and spans {} bytes; the file is damaged, write it again",
+                        column.column_path(),
+                        column.compressed_size()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Streams track points into a Parquet file.
@@ -173,14 +213,18 @@ pub(crate) fn read_parquet(
     each: &mut dyn FnMut(TrackPoint) -> Result<()>,
 ) -> Result<TrackLayout> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let reader = ParquetRecordBatchReaderBuilder::try_new(file)
-        .and_then(|b| b.build())
-        .map_err(|e| parquet_error(path, "read", e))?;
+    let read_error = |e: &dyn std::fmt::Display| parquet_error(path, "read", e);
+    let mut reader = without_panics(path, || {
+        let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| read_error(&e))?;
+        check_column_chunks(path, builder.metadata())?;
+        builder.build().map_err(|e| read_error(&e))
+    })?;
     let mut rows_read = 0;
     let mut layout = TrackLayout::Kinematics;
     let mut columns = TrackColumns::default();
-    for batch in reader {
-        let batch = batch.map_err(|e| parquet_error(path, "read", e))?;
+    while let Some(batch) = without_panics(path, || {
+        reader.next().transpose().map_err(|e| read_error(&e))
+    })? {
         columns.clear();
         let column = |name: &str, ty: &DataType| -> Result<Option<ArrayRef>> {
             batch
