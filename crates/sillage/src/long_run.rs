@@ -101,8 +101,9 @@ pub struct LongRunOutput<'a> {
     pub identity: RunIdentity,
 }
 
-/// Runs `pipeline` (no training passes) over the frames `open_inputs` gives into `output`,
-/// under `options`; `on_frame` sees every frame tracked by this process.
+/// Runs `pipeline` over the frames `open_inputs` gives into `output`, under `options`
+/// (checkpoints refuse a pipeline with training passes: those replay the whole sequence);
+/// `on_frame` sees every frame tracked by this process.
 pub fn run_long(
     pipeline: &mut Pipeline,
     open_inputs: &mut OpenInputs<'_>,
