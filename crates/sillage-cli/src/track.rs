@@ -11,15 +11,13 @@ use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use sillage::bedload::detector::BeadDetectorSources;
-use sillage::bedload::output::{BeadTrackKind, BeadTrackOutput};
+use sillage::bedload::output::BeadTrackKind;
+use sillage::bedload::run::{BeadSource, BedloadRun};
 use sillage::bedload::{BeadFrame, read_bead_frames};
-use sillage::checkpoint::RunIdentity;
-use sillage::io::{FrameOptions, SkippedFrame, TrackFormat, TrackWriter, open_frames};
-use sillage::long_run::{Inputs, LongRunOutput, OpenInputs, run_long};
-use sillage::toml_config::{dotted_keys, load_unvalidated};
+use sillage::io::{SkippedFrame, TrackFormat};
+use sillage::toml_config::load_unvalidated;
 use sillage::track::bedload::BedloadTrackerParams;
 use sillage::viz::OverlayStyle;
-use sillage::{DetectorConfig, FrameInput, Pipeline, PipelineConfig, TrackerConfig};
 
 use crate::overlay::{DetectionsByFrame, write_overlays};
 use crate::progress::FrameProgress;
@@ -181,93 +179,37 @@ fn output_kind(format: Option<BeadFormatArg>) -> Option<BeadTrackKind> {
 pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
     let params = load_bedload_params(args)?;
     let options = args.long_run.options()?;
-    let mut config = PipelineConfig {
-        tracker: TrackerConfig::Bedload(Box::new(params.clone())),
-        ..PipelineConfig::default()
+    let source = match (&args.input, &args.detections) {
+        (Some(input), _) => BeadSource::Frames {
+            input: input.clone(),
+            detector: Box::new(BeadDetectorSources::from(&args.detector).load()?),
+        },
+        (None, Some(detections)) => BeadSource::Detections {
+            name: detections.display().to_string(),
+            frames: read_inputs(args, detections)?,
+        },
+        (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
     };
-    let (total, source, mut open_inputs): (Option<usize>, String, Box<OpenInputs<'_>>) =
-        match (&args.input, &args.detections) {
-            (Some(input), _) => {
-                let sources = BeadDetectorSources::from(&args.detector);
-                config.detector = DetectorConfig::Bead(sources.load()?);
-                let frame_options = FrameOptions {
-                    on_bad_frame: options.on_bad_frame,
-                    ..FrameOptions::default()
-                };
-                let total = open_frames(input, &frame_options)?.len();
-                let source = input.clone();
-                let input = input.clone();
-                let open = move |start_at| -> sillage::core::Result<Inputs<'static>> {
-                    let options = FrameOptions {
-                        start_at,
-                        ..frame_options.clone()
-                    };
-                    let frames = open_frames(&input, &options)?;
-                    let log = frames.skipped();
-                    Ok((
-                        Box::new(frames.map(|f| f.map(FrameInput::Image))),
-                        Some(log),
-                    ))
-                };
-                (total, source, Box::new(open))
-            }
-            (None, Some(detections)) => {
-                let frames = read_inputs(args, detections)?;
-                let open = move |start_at| -> sillage::core::Result<Inputs<'static>> {
-                    let from: Vec<BeadFrame> = frames
-                        .iter()
-                        .filter(|f| f.frame >= start_at)
-                        .cloned()
-                        .collect();
-                    Ok((Box::new(from.into_iter().map(|f| Ok(f.into()))), None))
-                };
-                (None, detections.display().to_string(), Box::new(open))
-            }
-            (None, None) => anyhow::bail!("give frames to detect beads in, or --detections FILE"),
-        };
-    if let Some(total) = total {
-        params.check_sequence_length(total)?;
-    }
     let kind = match output_kind(args.format) {
         Some(kind) => kind,
         None => BeadTrackKind::from_path(&args.out)?,
     };
-    let mut pipeline = Pipeline::from_config(&config)?;
-    let mut create_writer = || -> sillage::core::Result<Box<dyn TrackWriter + Send>> {
-        Ok(Box::new(BeadTrackOutput::create(
-            &args.out,
-            Some(kind),
-            &params,
-        )?))
-    };
-    let mut settings = dotted_keys(&config)?;
-    settings.push(("format".to_string(), format!("{kind:?}")));
-    settings.extend(options.settings());
-    let output = LongRunOutput {
-        path: &args.out,
-        create_writer: &mut create_writer,
-        identity: RunIdentity::new("track bedload", &source, &args.out, settings),
-    };
+    let mut run = BedloadRun::open(&params, source, &options)?;
+    let total = run.frame_count();
     let mut progress = FrameProgress::new(total, "tracking");
     let start = Instant::now();
     let mut frames_here = 0u64;
     let mut kept = DetectionsByFrame::new();
-    let outcome = run_long(
-        &mut pipeline,
-        &mut open_inputs,
-        output,
-        &options,
-        &mut |report, observations| {
-            frames_here += 1;
-            if args.overlay.is_some() {
-                kept.insert(report.frame, observations.detections.to_vec());
-            }
-            progress.tick();
-        },
-    );
+    let outcome = run.run_long(&args.out, kind, &options, &mut |report, observations| {
+        frames_here += 1;
+        if args.overlay.is_some() {
+            kept.insert(report.frame, observations.detections.to_vec());
+        }
+        progress.tick();
+    });
     progress.finish();
     let elapsed = start.elapsed().as_secs_f64();
-    let tracked = outcome.with_context(|| format!("while tracking {source}"))?;
+    let tracked = outcome.with_context(|| format!("while tracking {}", run.source_name()))?;
     report_long_run(&tracked.skipped, tracked.resumed_after);
     let written = tracked.written;
     if let (Some(dir), Some(input)) = (&args.overlay, &args.input) {
@@ -280,7 +222,7 @@ pub fn run_bedload(args: &TrackBedloadArgs) -> Result<()> {
         let n = write_overlays(input, dir, &kept, tracks, &style, None)?;
         eprintln!("{n} overlays → {}", dir.display());
     }
-    let stats = pipeline.bedload_stats().unwrap_or_default();
+    let stats = run.stats();
     let summary = TrackSummary {
         tracker: params.tracker.name(),
         frames: stats.frames,

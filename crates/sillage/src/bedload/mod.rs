@@ -7,6 +7,7 @@
 pub mod detector;
 pub mod fit;
 pub mod output;
+pub mod run;
 pub mod synth;
 
 use std::collections::BTreeMap;
