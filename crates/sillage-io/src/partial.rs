@@ -128,16 +128,21 @@ pub(crate) fn write_target(path: &Path) -> Result<PathBuf> {
 
 /// `.NAME.partial` in the folder of `path`.
 pub(crate) fn partial_path(path: &Path) -> Result<PathBuf> {
+    hidden_beside(path, ".partial")
+}
+
+/// `.NAME` + `suffix` in the folder of `path`: the hidden files a run keeps beside its output.
+pub(crate) fn hidden_beside(path: &Path, suffix: &str) -> Result<PathBuf> {
     let name = path.file_name().ok_or_else(|| {
         Error::input(format!(
             "output path `{}` has no file name; give a file such as `out/tracks.csv`",
             path.display()
         ))
     })?;
-    let mut partial = std::ffi::OsString::from(".");
-    partial.push(name);
-    partial.push(".partial");
-    Ok(path.with_file_name(partial))
+    let mut hidden = std::ffi::OsString::from(".");
+    hidden.push(name);
+    hidden.push(suffix);
+    Ok(path.with_file_name(hidden))
 }
 
 #[cfg(test)]

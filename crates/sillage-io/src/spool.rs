@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use sillage_core::{BoundingBox, Error, MotionState, Point2, Result, TrackPoint, TrackSink, Vec2};
 
-use crate::partial::partial_path;
+use crate::partial::hidden_beside;
 
 /// Bytes of a point's fixed part: frame, track id, position, flags, state and class.
 const FIXED_LEN: usize = 39;
@@ -29,15 +29,7 @@ const BBOX: u16 = 1 << 6;
 
 /// `.NAME.rows.partial` beside the output `path`: where its rows are spooled.
 pub fn spool_path(path: &Path) -> Result<PathBuf> {
-    let partial = partial_path(path)?;
-    let mut name = partial.file_name().unwrap_or_default().to_os_string();
-    // `.NAME.partial` → `.NAME.rows.partial`
-    let text = name.to_string_lossy().into_owned();
-    name = text.strip_suffix(".partial").map_or_else(
-        || name.clone(),
-        |stem| format!("{stem}.rows.partial").into(),
-    );
-    Ok(partial.with_file_name(name))
+    hidden_beside(path, ".rows.partial")
 }
 
 /// Appends batches of track points to a spool file.
