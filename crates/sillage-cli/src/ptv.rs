@@ -7,10 +7,11 @@ use clap::Args;
 use serde::Serialize;
 use sillage::io::{SkippedFrame, TrackFormat};
 use sillage::ptv_run::{PtvRun, load_ptv_config};
-use sillage::{PipelineConfig, RunSummary};
+use sillage::windows::{WindowPlan, min_window};
+use sillage::{PipelineConfig, RunSummary, Tracking};
 
 use crate::progress::FrameProgress;
-use crate::shared_args::{ConfigArgs, FormatArg, JsonArg, LongRunArgs};
+use crate::shared_args::{ConfigArgs, FormatArg, JsonArg, LongRunArgs, WindowArgs};
 
 /// `sillage ptv`.
 #[derive(Debug, Args)]
@@ -29,6 +30,9 @@ pub struct PtvArgs {
     /// Bad frames, checkpoints and resume.
     #[command(flatten)]
     pub long_run: LongRunArgs,
+    /// Time windows tracked at once.
+    #[command(flatten)]
+    pub windows: WindowArgs,
     /// `--json`: a machine-readable summary on stdout.
     #[command(flatten)]
     pub json: JsonArg,
@@ -99,6 +103,9 @@ pub fn run(args: &PtvArgs) -> Result<()> {
     {
         eprintln!("{calibration}");
     }
+    if let Some(window) = args.windows.window {
+        return run_windowed(args, run, format, window);
+    }
     let mut progress = FrameProgress::new(run.frame_count(), "tracking");
     let outcome = run.run_long(&args.out, format, &options, &mut |report| {
         progress.frame(report)
@@ -133,6 +140,47 @@ pub fn run(args: &PtvArgs) -> Result<()> {
             tracked.written.path.display(),
             summary.detect_ms_per_frame,
             summary.track_ms_per_frame
+        );
+    }
+    Ok(())
+}
+
+/// `sillage ptv … --window W`: the windows tracked `--jobs` at once, stitched into `--out`.
+fn run_windowed(args: &PtvArgs, run: PtvRun, format: TrackFormat, window: usize) -> Result<()> {
+    let frames = run.frame_count().ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: the number of frames is unknown (a video without a frame count); windows \
+             need it: convert the video to an image sequence",
+            args.input
+        )
+    })?;
+    let tracking = Tracking::Pipeline(Box::new(load_config(&args.config)?));
+    let plan = WindowPlan::new(
+        frames as u64,
+        window,
+        args.windows.overlap,
+        min_window(&tracking),
+    )?;
+    let jobs = args.windows.jobs();
+    let mut progress = FrameProgress::new(Some(plan.windows().len()), "windows");
+    let outcome = run.run_windowed(&args.out, format, plan, jobs, &mut |_| progress.tick());
+    progress.finish();
+    let (summary, written) = outcome?;
+    if args.json.enabled {
+        let json = serde_json::json!({ "windows": summary, "rows": written.rows });
+        println!("{}", serde_json::to_string_pretty(&json)?);
+    } else {
+        let joined: usize = summary.seams.iter().map(|s| s.joined).sum();
+        eprintln!(
+            "{} windows of {window} frames overlapping by {} ({} at once): {} track points in \
+             {} tracks → {}; {joined} tracks joined across {} seams",
+            summary.windows,
+            plan.overlap,
+            summary.jobs,
+            summary.points,
+            summary.tracks,
+            written.path.display(),
+            summary.seams.len()
         );
     }
     Ok(())

@@ -201,3 +201,27 @@ impl LongRunArgs {
         }
     }
 }
+
+/// `--window`, `--overlap`, `--jobs`: a run split into overlapping time windows tracked at
+/// once and stitched into one set of trajectories.
+#[derive(Debug, Args, Clone)]
+pub struct WindowArgs {
+    /// Track in time windows of W frames, several at once, stitched into one set of
+    /// trajectories (docs/scale.md); not with checkpoints.
+    #[arg(long, value_name = "W", conflicts_with_all = ["checkpoint_every", "resume"])]
+    pub window: Option<usize>,
+    /// Frames shared by consecutive windows: at least 4, at most half the window.
+    #[arg(long, value_name = "O", default_value_t = sillage::windows::DEFAULT_OVERLAP, requires = "window")]
+    pub overlap: usize,
+    /// Windows tracked at once (default: one per core).
+    #[arg(long, value_name = "J", requires = "window")]
+    pub jobs: Option<usize>,
+}
+
+impl WindowArgs {
+    /// Windows tracked at once: `--jobs`, or one per core.
+    pub fn jobs(&self) -> usize {
+        self.jobs
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+    }
+}

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
-use sillage::io::MotResultsWriter;
+use sillage::io::{FrameOptions, MotResultsWriter};
 use sillage::pedestrian::immpf::{ImmpfRun, ModelWeightsWriter, Scene, mot_rows};
 use sillage::pedestrian::input::frame_size_beside;
 use sillage::pedestrian::{ImmpfSettings, PedestrianInput};
@@ -106,7 +106,10 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         size,
         &settings.motion_params(args.ground_plane.is_some()),
         &params.appearance,
-        args.max_frames,
+        &FrameOptions {
+            max_frames: args.max_frames,
+            ..FrameOptions::default()
+        },
         args.overlay.is_some(),
     )?;
     let tracking = ImmpfRun::new(input, params, scene, args.seed)?;

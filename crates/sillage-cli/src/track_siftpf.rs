@@ -7,7 +7,7 @@ use std::time::Duration;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
-use sillage::io::MotResultsWriter;
+use sillage::io::{FrameOptions, MotResultsWriter};
 use sillage::pedestrian::siftpf::track_siftpf;
 use sillage::pedestrian::{GroundPlaneFile, SiftPfSettings};
 
@@ -74,7 +74,10 @@ pub fn run(args: &TrackSiftpfArgs) -> Result<()> {
         &settings,
         homography,
         args.seed,
-        args.max_frames,
+        &FrameOptions {
+            max_frames: args.max_frames,
+            ..FrameOptions::default()
+        },
         &mut |expected| {
             progress
                 .get_or_insert_with(|| FrameProgress::new(expected, "tracking"))

@@ -108,6 +108,39 @@ fn three_page_tiff_stack_gives_three_frames() {
     assert!(frames.iter().all(|f| f.path == path));
 }
 
+/// The frame indices `options` reads from `input`.
+fn indices_read(input: &Path, options: &FrameOptions) -> Vec<u64> {
+    open_frames(input.to_str().unwrap(), options)
+        .unwrap()
+        .map(|f| f.unwrap().index)
+        .collect()
+}
+
+#[test]
+fn a_time_window_reads_its_frames_only_from_files_and_stacks() {
+    let dir = tempfile::tempdir().unwrap();
+    for i in 0..8u8 {
+        gray8(&dir.path().join(format!("f{i}.png")), 4, 4, 10 * i);
+    }
+    let stack = dir.path().join("stack.tif");
+    tiff16_pages(&stack, 4, 4, &[0, 1, 2, 3, 4, 5, 6, 7]);
+    let window = FrameOptions {
+        start_at: 2,
+        stop_at: Some(6),
+        ..FrameOptions::default()
+    };
+    for input in [dir.path().join("*.png"), stack] {
+        assert_eq!(indices_read(&input, &window), [2, 3, 4, 5], "{input:?}");
+        let to_the_end = FrameOptions {
+            stop_at: Some(100),
+            ..window.clone()
+        };
+        assert_eq!(indices_read(&input, &to_the_end), [2, 3, 4, 5, 6, 7]);
+    }
+    let files = open_frames(dir.path().to_str().unwrap(), &window).unwrap();
+    assert_eq!(files.len(), Some(4), "a window's length, for progress bars");
+}
+
 #[test]
 fn float_tiff_is_kept_as_is_and_max_frames_limits() {
     let dir = tempfile::tempdir().unwrap();

@@ -14,6 +14,7 @@ mod linking;
 mod sources;
 mod stream;
 mod synth;
+mod windows;
 
 use numpy::{IntoPyArray, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -266,6 +267,13 @@ fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(experiments::fit, module)?)?;
     module.add_function(wrap_pyfunction!(experiments::bench_immpf, module)?)?;
     module.add_function(wrap_pyfunction!(experiments::bench_siftpf, module)?)?;
+    module.add_function(wrap_pyfunction!(windows::frame_count, module)?)?;
+    module.add_function(wrap_pyfunction!(windows::plan_windows, module)?)?;
+    module.add_function(wrap_pyfunction!(windows::track_window, module)?)?;
+    module.add_function(wrap_pyfunction!(windows::track_window_frames, module)?)?;
+    module.add_function(wrap_pyfunction!(windows::track_windows, module)?)?;
+    module.add_class::<windows::Stitcher>()?;
+    module.add("DEFAULT_OVERLAP", sillage::windows::DEFAULT_OVERLAP)?;
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

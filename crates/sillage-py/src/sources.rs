@@ -2,6 +2,7 @@
 //! any of the four trackers and three detectors of `sillage::tracking`, their settings given
 //! as dotted `key=value` overrides of each one's configuration.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use numpy::IntoPyArray;
@@ -11,6 +12,7 @@ use pyo3::types::PyDict;
 use sillage::bedload::detector::BeadDetectorSources;
 use sillage::core::{BoundingBox, Result, TrackPoint};
 use sillage::detect::motion::MotionParams;
+use sillage::io::FrameOptions;
 use sillage::pedestrian::immpf::Scene;
 use sillage::pedestrian::{GroundPlaneFile, ImmpfSettings, SiftPfSettings};
 use sillage::toml_config::load;
@@ -27,7 +29,7 @@ use crate::track_columns;
 
 /// The files some trackers and detectors read besides their frames.
 #[derive(Debug, Default)]
-struct SceneFiles {
+pub(crate) struct SceneFiles {
     /// BeadTracking `sequence_param.txt` (bead detector).
     sequence_params: Option<PathBuf>,
     /// Image of the fixed flume base (bead detector).
@@ -70,8 +72,33 @@ fn pipeline_config(
     Ok(config)
 }
 
+impl SceneFiles {
+    /// The files of a dict of `sequence_params`, `mask`, `ground_plane`, `motion_prior`,
+    /// `detections` (each optional); another key raises `ValueError`.
+    pub(crate) fn from_dict(files: HashMap<String, PathBuf>) -> PyResult<Self> {
+        let mut scene = SceneFiles::default();
+        for (key, path) in files {
+            let slot = match key.as_str() {
+                "sequence_params" => &mut scene.sequence_params,
+                "mask" => &mut scene.base_mask,
+                "ground_plane" => &mut scene.ground_plane,
+                "motion_prior" => &mut scene.motion_prior,
+                "detections" => &mut scene.detections,
+                other => {
+                    return Err(PyValueError::new_err(format!(
+                        "unknown file `{other}`; give sequence_params, mask, ground_plane, \
+                         motion_prior or detections"
+                    )));
+                }
+            };
+            *slot = Some(path);
+        }
+        Ok(scene)
+    }
+}
+
 /// The tracking named `tracker` with `overrides` of its configuration.
-fn tracking(
+pub(crate) fn tracking(
     tracker: &str,
     overrides: &[String],
     seed: u64,
@@ -134,8 +161,20 @@ fn add_boxes<'a>(
     column("bb_height", |b| b.height_px)
 }
 
+/// The columns of any tracker's points: those of `track_columns`, then `state`, `class` and
+/// the box columns.
+pub(crate) fn all_track_columns<'py>(
+    py: Python<'py>,
+    points: &[TrackPoint],
+) -> PyResult<Bound<'py, PyDict>> {
+    let columns = track_columns(py, points)?;
+    add_state_and_class(&columns, points)?;
+    add_boxes(&columns, points.iter().map(|p| p.bbox.as_ref()))?;
+    Ok(columns)
+}
+
 /// Tracks the frames of `source` with `tracker` (`ptv`, `bedload`, `immpf`, `siftpf`);
-/// returns the columns of `track_columns`, then `state`, `class` and the box columns.
+/// returns the columns of `all_track_columns`.
 #[pyfunction]
 #[pyo3(signature = (source, tracker, overrides, seed=1, sequence_params=None, mask=None,
     ground_plane=None, motion_prior=None, detections=None, max_frames=None, progress=None))]
@@ -166,17 +205,18 @@ pub fn track<'py>(
         let between = Between::new(progress);
         let run = || {
             let mut points: Vec<TrackPoint> = Vec::new();
-            track_source(&source, &setup, max_frames, &mut points, &mut || {
+            let frames = FrameOptions {
+                max_frames,
+                ..FrameOptions::default()
+            };
+            track_source(&source, &setup, &frames, &mut points, &mut || {
                 between.advance()
             })?;
             Ok(points)
         };
         between.result(run())
     })?;
-    let columns = track_columns(py, &points)?;
-    add_state_and_class(&columns, &points)?;
-    add_boxes(&columns, points.iter().map(|p| p.bbox.as_ref()))?;
-    Ok(columns)
+    all_track_columns(py, &points)
 }
 
 /// Detects objects in the frames of `source` with `detector` (`blob`, `bead`, `motion`);

@@ -1,5 +1,7 @@
 //! The synthetic generators: frames as numpy arrays, ground truth and detections as columns.
 
+use std::path::PathBuf;
+
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray3};
 use pyo3::prelude::*;
@@ -8,6 +10,7 @@ use sillage::core::{Detection, Error, FrameIndex, Result, TrackPoint, TruthPoint
 use sillage::synth::vortex::{VortexParams, VortexSequence};
 use sillage::synth::{BedloadDetectionParams, BedloadSceneParams, BedloadSequence};
 use sillage::toml_config::set_key;
+use sillage::vortex_files::write_vortex;
 
 use crate::bedload::add_state_and_class;
 use crate::errors::to_py;
@@ -16,17 +19,24 @@ use crate::kinematic_columns;
 /// Renders the vortex flow of the TracTrac paper (§4.1.1) with `overrides` (`key=value`,
 /// keys of `VortexParams`: `width`, `n_particles`, `snr`...); returns the frames as a
 /// float32 array `(frames, rows, columns)` in `[0, 1]` and the truth's columns `frame`,
-/// `particle`, `x`, `y`, `vx`, `vy`.
+/// `particle`, `x`, `y`, `vx`, `vy`. With `out`, the frames are also written there as
+/// `frame_NNNNN.png` (16-bit) with `truth.csv`, as `sillage synth vortex` writes them.
 #[pyfunction]
+#[pyo3(signature = (overrides, out=None))]
 pub fn synth_vortex<'py>(
     py: Python<'py>,
     overrides: Vec<String>,
+    out: Option<PathBuf>,
 ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyDict>)> {
     let mut params = VortexParams::default();
     for assignment in &overrides {
         set_key(&mut params, assignment).map_err(to_py)?;
     }
     params.validate().map_err(to_py)?;
+    if let Some(out) = &out {
+        py.detach(|| write_vortex(&params, out, &mut || {}))
+            .map_err(to_py)?;
+    }
     let (pixels, truth) = py.detach(|| render(&params)).map_err(to_py)?;
     let frames = Array3::from_shape_vec((params.n_frames, params.height, params.width), pixels)
         .map_err(|e| to_py(Error::input(format!("frames of unexpected size: {e}"))))?;

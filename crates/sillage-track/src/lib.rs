@@ -9,6 +9,7 @@
 //!   (Madrigal & Hayet).
 //! - [`sort`]: SORT (Bewley et al. 2016), the box-tracking baseline on detections;
 //!   [`bytetrack`]: ByteTrack (Zhang et al. 2022), as `supervision` implements it.
+//! - [`stitch`]: joins the tracks of overlapping time windows tracked apart (distributed runs).
 //!
 //! ```
 //! use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker};
@@ -38,3 +39,4 @@ pub mod immpf;
 pub mod ptv;
 pub mod siftpf;
 pub mod sort;
+pub mod stitch;

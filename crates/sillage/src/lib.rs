@@ -11,7 +11,9 @@
 //!   fits and outputs; [`experiments`]: each paper's tables, medians over seeds;
 //! - [`evaluate`], [`tables`]: truth and tracks of every format, scored as TrackEval does;
 //! - [`toml_config`]: every command's settings, read once and validated
-//!   ([`toml_config::load`]).
+//!   ([`toml_config::load`]);
+//! - [`windows`]: a long run split into overlapping time windows tracked in parallel and
+//!   stitched back into one set of trajectories.
 //!
 //! ```no_run
 //! use sillage::{Pipeline, PipelineConfig};
@@ -56,6 +58,7 @@ pub mod tractrac;
 pub mod tune;
 pub mod viewer;
 pub mod vortex_files;
+pub mod windows;
 
 pub use config::{DetectorConfig, PipelineConfig, TrackerConfig};
 pub use detection_stage::DetectionStage;

@@ -17,7 +17,9 @@ use crate::config::{DetectorConfig, PipelineConfig};
 use crate::long_run::{Inputs, LongRunOptions, LongRunOutput, run_long};
 use crate::pipeline::{FrameInput, FrameReport, Pipeline, RunSummary};
 use crate::toml_config::{Settings, dotted_keys, load_unvalidated, set_key};
+use crate::tracking::Tracking;
 use crate::tractrac::apply_par;
+use crate::windows::{Window, WindowPlan, WindowedRun, WindowedSummary};
 
 impl Settings for PipelineConfig {
     fn validate(&self) -> Result<()> {
@@ -88,7 +90,8 @@ pub struct PtvRun {
     header: TrackFileHeader,
     background_frames: Option<usize>,
     frame_count: Option<usize>,
-    on_bad_frame: BadFramePolicy,
+    /// The frames to track (their span and the bad-frame policy).
+    frames: FrameOptions,
 }
 
 /// What [`PtvRun::run_to_file`] did.
@@ -120,22 +123,33 @@ impl PtvRun {
         input: &str,
         on_bad_frame: BadFramePolicy,
     ) -> Result<Self> {
-        let options = FrameOptions {
+        let frames = FrameOptions {
             on_bad_frame,
             ..FrameOptions::default()
         };
+        Self::open_frames(config, input, frames)
+    }
+
+    /// [`PtvRun::open`] on the frames `frames` selects (a time window: its `start_at`,
+    /// `stop_at`, `max_frames`; its bad-frame policy). The background model starts from the
+    /// selected frames; an `"auto"` blob scale or polarity is measured on the sequence's first
+    /// frame, whatever the selection, so that every window of a run detects alike.
+    pub fn open_frames(config: &PipelineConfig, input: &str, frames: FrameOptions) -> Result<Self> {
         let mut pipeline = Pipeline::from_config(config)?;
         let background_frames = if pipeline.background_init_frames() > 0 {
-            Some(pipeline.prime_background(open_frames(input, &options)?)?)
+            Some(pipeline.prime_background(open_frames(input, &frames)?)?)
         } else {
             None
         };
-        let mut probe = open_frames(input, &options)?;
-        let frame_count = probe.len();
-        if let DetectorConfig::Blob(_) = config.detector
-            && let Some(first) = probe.next()
-        {
-            pipeline.calibrate(&first?)?;
+        let frame_count = open_frames(input, &frames)?.len();
+        if let DetectorConfig::Blob(_) = config.detector {
+            let first_frame = FrameOptions {
+                on_bad_frame: frames.on_bad_frame,
+                ..FrameOptions::default()
+            };
+            if let Some(first) = open_frames(input, &first_frame)?.next() {
+                pipeline.calibrate(&first?)?;
+            }
         }
         Ok(Self {
             header: track_header(config, pipeline.calibration().as_ref())?,
@@ -144,7 +158,7 @@ impl PtvRun {
             config: config.clone(),
             background_frames,
             frame_count,
-            on_bad_frame,
+            frames,
         })
     }
 
@@ -171,9 +185,8 @@ impl PtvRun {
     /// The frame options of this run's source, from frame `start_at` on.
     fn frame_options(&self, start_at: FrameIndex) -> FrameOptions {
         FrameOptions {
-            on_bad_frame: self.on_bad_frame,
-            start_at,
-            ..FrameOptions::default()
+            start_at: start_at.max(self.frames.start_at),
+            ..self.frames.clone()
         }
     }
 
@@ -196,7 +209,7 @@ impl PtvRun {
         on_frame: &mut dyn FnMut(&FrameReport),
     ) -> Result<PtvFileRun> {
         let options = LongRunOptions {
-            on_bad_frame: self.on_bad_frame,
+            on_bad_frame: self.frames.on_bad_frame,
             ..LongRunOptions::default()
         };
         self.run_long(out, format, &options, on_frame)
@@ -211,7 +224,7 @@ impl PtvRun {
         options: &LongRunOptions,
         on_frame: &mut dyn FnMut(&FrameReport),
     ) -> Result<PtvFileRun> {
-        if options.on_bad_frame != self.on_bad_frame {
+        if options.on_bad_frame != self.frames.on_bad_frame {
             return Err(Error::input(
                 "the bad-frame policy differs from the one the run was opened with",
             ));
@@ -255,6 +268,33 @@ impl PtvRun {
             skipped: outcome.skipped,
             resumed_after: outcome.resumed_after,
         })
+    }
+}
+
+impl PtvRun {
+    /// Tracks the sequence in the time windows of `plan`, `jobs` at once, stitched into the
+    /// track file `out` ([`crate::windows`]); `on_window` is called as each window is
+    /// stitched. Rows written before an error stay valid: the file is completed either way,
+    /// then the error is returned.
+    pub fn run_windowed(
+        self,
+        out: &Path,
+        format: TrackFormat,
+        plan: WindowPlan,
+        jobs: usize,
+        on_window: &mut dyn FnMut(&Window),
+    ) -> Result<(WindowedSummary, WrittenSummary)> {
+        if self.frames.on_bad_frame != BadFramePolicy::Stop {
+            return Err(Error::input(
+                "windows read every frame: skipping bad frames is not available with windows",
+            ));
+        }
+        let tracking = Tracking::Pipeline(Box::new(self.config));
+        let mut writer = create_track_writer(out, format, &self.header)?;
+        let run = WindowedRun::new(&tracking, plan).jobs(jobs);
+        let summary = run.run(&self.input, &mut *writer, on_window);
+        let written = writer.finish()?;
+        Ok((summary?, written))
     }
 }
 

@@ -21,6 +21,7 @@ use sillage_track::immpf::PedestrianEstimate;
 use crate::pedestrian::immpf::{ImmpfRun, Scene};
 use crate::pedestrian::siftpf::track_siftpf;
 use crate::pedestrian::{ImmpfSettings, PedestrianInput, SiftPfSettings};
+use crate::ptv_run::PtvRun;
 use crate::{Pipeline, PipelineConfig};
 
 /// One of the four trackers with everything it needs besides its frames.
@@ -77,28 +78,20 @@ fn immpf_point(e: &PedestrianEstimate) -> TrackPoint {
     person_point(e.frame, e.track_id, e.bbox, Some(e.vel_px_per_frame))
 }
 
-/// Tracks the frames of `source` (the first `max_frames`) with `tracking`, handing the
-/// points to `sink` as they become final; `on_frame` is called after each frame. Returns the
-/// number of frames tracked.
+/// Tracks the frames of `source` that `frames` selects (all, the first `max_frames`, or a
+/// time window `start_at..stop_at`) with `tracking`, handing the points to `sink` as they
+/// become final; `on_frame` is called after each frame. Returns the number of frames tracked.
 pub fn track_source(
     source: &str,
     tracking: &Tracking,
-    max_frames: Option<usize>,
+    frames: &FrameOptions,
     sink: &mut dyn TrackSink,
     on_frame: &mut dyn FnMut(),
 ) -> Result<u64> {
     match tracking {
         Tracking::Pipeline(config) => {
-            let options = FrameOptions {
-                max_frames,
-                ..FrameOptions::default()
-            };
-            let mut pipeline = Pipeline::from_config(config)?;
-            if pipeline.background_init_frames() > 0 {
-                pipeline.prime_background(open_frames(source, &options)?)?;
-            }
-            let frames = open_frames(source, &options)?;
-            let summary = pipeline.run(frames, sink, &mut |_| on_frame())?;
+            let run = PtvRun::open_frames(config, source, frames.clone())?;
+            let summary = run.run(sink, &mut |_| on_frame())?;
             Ok(summary.frames)
         }
         Tracking::Immpf(setup) => {
@@ -109,7 +102,7 @@ pub fn track_source(
                 None,
                 &motion,
                 &setup.settings.tracker.appearance,
-                max_frames,
+                frames,
                 false,
             )?;
             let run = ImmpfRun::new(
@@ -133,7 +126,7 @@ pub fn track_source(
                 &setup.settings,
                 setup.homography,
                 setup.seed,
-                max_frames,
+                frames,
                 &mut |_| on_frame(),
             )?;
             let points: Vec<TrackPoint> = run

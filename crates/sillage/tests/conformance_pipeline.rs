@@ -12,6 +12,7 @@ use std::path::PathBuf;
 
 use sillage::bedload::detector::BeadDetectorSources;
 use sillage::core::TrackPoint;
+use sillage::io::FrameOptions;
 use sillage::pedestrian::immpf::Scene;
 use sillage::pedestrian::{ImmpfSettings, SiftPfSettings};
 use sillage::tracking::{ImmpfSetup, SiftPfSetup};
@@ -72,6 +73,14 @@ fn cases() -> Vec<(&'static str, String, Tracking, bool)> {
     ]
 }
 
+/// The first `frames` frames of a source.
+fn first(frames: usize) -> FrameOptions {
+    FrameOptions {
+        max_frames: Some(frames),
+        ..FrameOptions::default()
+    }
+}
+
 fn run(source: &str, tracking: &Tracking, threads: usize) -> Vec<TrackPoint> {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -80,7 +89,7 @@ fn run(source: &str, tracking: &Tracking, threads: usize) -> Vec<TrackPoint> {
         .install(|| {
             let mut points = Vec::new();
             let mut frames_seen = 0;
-            let frames = track_source(source, tracking, Some(FRAMES), &mut points, &mut || {
+            let frames = track_source(source, tracking, &first(FRAMES), &mut points, &mut || {
                 frames_seen += 1
             })
             .unwrap();
@@ -127,7 +136,13 @@ fn every_tracker_refuses_a_source_without_frames() {
     let source = empty.path().to_str().unwrap();
     for (name, _, tracking, _) in cases() {
         let mut points = Vec::new();
-        let outcome = track_source(source, &tracking, None, &mut points, &mut || {});
+        let outcome = track_source(
+            source,
+            &tracking,
+            &FrameOptions::default(),
+            &mut points,
+            &mut || {},
+        );
         let err = outcome.expect_err(name).to_string();
         assert!(
             err.contains(source),

@@ -46,6 +46,9 @@ pub struct FrameOptions {
     /// Frames of a lower index are passed over (a resumed run): files are not even decoded,
     /// pages and video frames are decoded and dropped. Default 0.
     pub start_at: FrameIndex,
+    /// Frames of this index and above are not read (a time window of a longer run); `None`:
+    /// read to the end.
+    pub stop_at: Option<FrameIndex>,
 }
 
 impl Default for FrameOptions {
@@ -58,6 +61,7 @@ impl Default for FrameOptions {
             colour: false,
             on_bad_frame: BadFramePolicy::Stop,
             start_at: 0,
+            stop_at: None,
         }
     }
 }
@@ -122,6 +126,7 @@ pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
         policy: options.on_bad_frame,
         skipped: skipped.clone(),
         start_at: options.start_at,
+        stop_at: options.stop_at,
     };
     let (len, dimensions, paths, worker) = match input::resolve(input)? {
         InputKind::Files(mut files) => {
@@ -133,6 +138,11 @@ pub fn open_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
             let passed_over = indices.partition_point(|&i| i < options.start_at);
             files.drain(..passed_over);
             indices.drain(..passed_over);
+            if let Some(stop_at) = options.stop_at {
+                let kept = indices.partition_point(|&i| i < stop_at);
+                files.truncate(kept);
+                indices.truncate(kept);
+            }
             let len = files.len();
             let worker_files = files.clone();
             let worker = spawn(reading, dimensions, Some(indices), move |emitter| {
@@ -231,6 +241,7 @@ struct Reading {
     policy: BadFramePolicy,
     skipped: SkippedFrames,
     start_at: FrameIndex,
+    stop_at: Option<FrameIndex>,
 }
 
 /// Starts the reading thread, which runs `read` with an [`Emitter`]; `indices` are the frame
@@ -274,9 +285,13 @@ impl Emitter {
             .unwrap_or(self.position as FrameIndex)
     }
 
-    /// Whether the position is past the frame limit.
+    /// Whether the position is past the frame limit, or its index past the last to read.
     fn past_limit(&self) -> bool {
         self.reading.max_frames.is_some_and(|m| self.position >= m)
+            || self
+                .reading
+                .stop_at
+                .is_some_and(|stop| self.index() >= stop)
     }
 
     /// Sends one decoded frame; `false` means stop reading.

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import json
 import numbers
+import os
 import sys
 from typing import Any, Iterable, Iterator, Mapping
 
@@ -64,6 +65,14 @@ _DETECTOR_COLUMNS = {
     "bead": _DETECTION_COLUMNS + ["class"],
     "motion": _DETECTION_COLUMNS + _BOX_COLUMNS,
 }
+
+
+def __getattr__(name: str) -> Any:
+    """``sillage.dask`` is imported on first use (it needs the optional dask packages)."""
+    if name == "dask":
+        import importlib
+        return importlib.import_module(".dask", __name__)
+    raise AttributeError(f"module 'sillage' has no attribute {name!r}")
 
 
 def config_keys() -> list[str]:
@@ -220,6 +229,8 @@ def track(source: str | Any, tracker: str = "ptv", *, seed: int = 1,
           sequence_params: str | Any | None = None, mask: str | Any | None = None,
           ground_plane: str | Any | None = None, motion_prior: str | Any | None = None,
           detections: str | Any | None = None, max_frames: int | None = None,
+          window: int | None = None, overlap: int = _sillage.DEFAULT_OVERLAP,
+          jobs: int | None = None,
           params: Mapping[str, Any] | None = None, progress: bool = False,
           **keywords: Any) -> pd.DataFrame:
     """Tracks the frames of ``source`` with any of sillage's four trackers.
@@ -246,6 +257,11 @@ def track(source: str | Any, tracker: str = "ptv", *, seed: int = 1,
     accelerations ``ax``, ``ay``, ``state`` and ``class`` (bedload) or the box
     ``bb_left``, ``bb_top``, ``bb_width``, ``bb_height`` (pedestrians).
 
+    With ``window``, the sequence is tracked in windows of that many frames sharing
+    ``overlap`` frames, ``jobs`` at once on this machine's cores (default: one per core), and
+    stitched into one set of trajectories, as ``sillage ptv --window`` does (the same result
+    as :func:`sillage.dask.track` on a cluster; see ``docs/scale.md``).
+
     >>> people = sillage.track("PETS09-S2L1/img1", "immpf", ground_plane="ground.toml",
     ...                        models=["cv", "ca"], seed=1)
     >>> people.groupby("particle").size()
@@ -254,6 +270,21 @@ def track(source: str | Any, tracker: str = "ptv", *, seed: int = 1,
         raise ValueError(f"unknown tracker `{tracker}`; choose one of {sorted(_TRACKER_COLUMNS)}")
     section = None if tracker == "ptv" else "tracker"
     overrides = _overrides(keywords, params, section)
+    if window is not None:
+        if max_frames is not None:
+            raise ValueError("give window or max_frames, not both")
+        files = {name: _path(path) for name, path in [
+            ("sequence_params", sequence_params), ("mask", mask),
+            ("ground_plane", ground_plane), ("motion_prior", motion_prior),
+            ("detections", detections)] if path is not None}
+        jobs = (os.cpu_count() or 1) if jobs is None else int(jobs)
+        with _progress(progress, None, f"{tracker} windows") as update:
+            columns, summary = _sillage.track_windows(_path(source), tracker, overrides,
+                                                      int(seed), files, int(window),
+                                                      int(overlap), jobs, update)
+        tracks = pd.DataFrame(columns)[_TRACKER_COLUMNS[tracker]]
+        tracks.attrs["seams"] = json.loads(summary)["seams"]
+        return tracks
     with _progress(progress, max_frames, tracker) as update:
         columns = _sillage.track(_path(source), tracker, overrides, int(seed),
                                  _optional_path(sequence_params), _optional_path(mask),
@@ -475,7 +506,8 @@ def bench(kind: str, sequences: Iterable[str | Any], *, runs: int = 1,
     return pd.json_normalize(rows, sep="_")
 
 
-def synth_vortex(**params: Any) -> tuple[np.ndarray, pd.DataFrame]:
+def synth_vortex(*, out: str | Any | None = None,
+                 **params: Any) -> tuple[np.ndarray, pd.DataFrame]:
     """Renders the synthetic vortex flow of the TracTrac paper (§4.1.1), with ground truth.
 
     Keywords are the generator's keys: ``width``, ``height`` (px, default 1024),
@@ -483,7 +515,9 @@ def synth_vortex(**params: Any) -> tuple[np.ndarray, pd.DataFrame]:
     ``intermittency`` (0), ``brownian`` (0), ``blob_sigma_px`` (2), ``peak`` (0.5), ``seed``
     (0). Returns the frames, a float32 array ``(frames, rows, columns)`` of grey levels in
     [0, 1], and the truth: one row per particle and frame with ``frame``, ``particle``,
-    ``x``, ``y`` and the true displacement to the next frame ``vx``, ``vy``.
+    ``x``, ``y`` and the true displacement to the next frame ``vx``, ``vy``. With ``out`` (a
+    folder), the frames are also written there as 16-bit PNG ``frame_00000.png``... with
+    ``truth.csv``, as ``sillage synth vortex`` writes them.
 
     >>> frames, truth = sillage.synth_vortex(n_particles=500, n_frames=8, seed=1)
     >>> frames.shape
@@ -492,7 +526,7 @@ def synth_vortex(**params: Any) -> tuple[np.ndarray, pd.DataFrame]:
     assignments: list[str] = []
     for name, value in params.items():
         _assign(name, value, assignments)
-    frames, truth = _sillage.synth_vortex(assignments)
+    frames, truth = _sillage.synth_vortex(assignments, None if out is None else _path(out))
     return frames, pd.DataFrame(truth)
 
 

@@ -5,6 +5,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 __version__: str
+DEFAULT_OVERLAP: int
 
 Columns = dict[str, np.ndarray]
 Progress = Optional[Callable[[int], Any]]
@@ -19,7 +20,7 @@ def link(
     overrides: list[str],
     progress: Progress = None,
 ) -> Columns: ...
-def synth_vortex(overrides: list[str]) -> tuple[np.ndarray, Columns]: ...
+def synth_vortex(overrides: list[str], out: Optional[str] = None) -> tuple[np.ndarray, Columns]: ...
 def synth_bedload(
     scene_overrides: list[str], detection_overrides: list[str]
 ) -> tuple[Columns, Columns, Columns]: ...
@@ -81,3 +82,30 @@ def bench_siftpf(
     max_frames: Optional[int] = None,
     progress: Progress = None,
 ) -> str: ...
+
+Files = dict[str, str]
+Window = tuple[int, int, int]
+
+def frame_count(source: str) -> int: ...
+def plan_windows(
+    frames: int, window: int, overlap: int, tracker: str, overrides: list[str], seed: int,
+    files: Files,
+) -> list[Window]: ...
+def track_window(
+    source: str, tracker: str, overrides: list[str], seed: int, files: Files, index: int,
+    first: int, last: int, threads: Optional[int] = None,
+) -> bytes: ...
+def track_window_frames(
+    frames: np.ndarray, first_frame: np.ndarray, tracker: str, overrides: list[str],
+    seed: int, files: Files, index: int, first: int, last: int,
+    threads: Optional[int] = None,
+) -> bytes: ...
+def track_windows(
+    source: str, tracker: str, overrides: list[str], seed: int, files: Files, window: int,
+    overlap: int, jobs: int, progress: Progress = None,
+) -> tuple[Columns, str]: ...
+
+class Stitcher:
+    def __init__(self, tracker: str, overrides: list[str], seed: int, files: Files) -> None: ...
+    def push(self, tracks: bytes) -> Columns: ...
+    def finish(self) -> tuple[Columns, str]: ...

@@ -15,6 +15,7 @@ use sillage_detect::motion::MotionParams;
 use sillage_eval::papers::vace;
 use sillage_eval::{MotParams, evaluate_mot};
 use sillage_filter::{MotionPrior, MotionPriorParams};
+use sillage_io::FrameOptions;
 use sillage_track::bytetrack::ByteTrackParams;
 use sillage_track::immpf::{
     BoxSizing, ModelName, PedestrianEstimate, PedestrianParams, PedestrianTracker,
@@ -213,7 +214,10 @@ impl Sequence {
             frame_size_beside(&detections),
             motion,
             &params.appearance,
-            input.max_frames,
+            &FrameOptions {
+                max_frames: input.max_frames,
+                ..FrameOptions::default()
+            },
             false,
         )?;
         let mut frames = Vec::new();

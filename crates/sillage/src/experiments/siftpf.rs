@@ -12,6 +12,7 @@ use serde::Serialize;
 use sillage_core::{Error, Homography, Result};
 use sillage_eval::mot::{MotMetrics, MotParams, clear_events, evaluate_mot};
 use sillage_eval::papers::{EtiseoMetrics, etiseo};
+use sillage_io::FrameOptions;
 use sillage_track::siftpf::FeatureSelection;
 
 use super::median_over;
@@ -304,7 +305,10 @@ impl RunOf<'_> {
             self.settings,
             self.homography,
             self.seed,
-            self.max_frames,
+            &FrameOptions {
+                max_frames: self.max_frames,
+                ..FrameOptions::default()
+            },
             on_frame,
         )?;
         let boxes = run.estimates.iter().map(|e| (e.frame, e.id, e.bbox));

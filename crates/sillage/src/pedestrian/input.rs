@@ -74,7 +74,8 @@ pub fn frame_size_beside(file: &Path) -> Option<(usize, usize)> {
 
 impl PedestrianInput {
     /// Colour frames of `input` (motion blobs as candidates unless `detections` is given),
-    /// or, without `input`, the detections alone over frames of `frame_size_px`;
+    /// or, without `input`, the detections alone over frames of `frame_size_px`; `frames`
+    /// selects the frames (`start_at`, `stop_at`, `max_frames`; colour is always decoded);
     /// `keep_colour` keeps each colour frame in [`PreparedFrame::colour`].
     pub fn open(
         input: Option<&str>,
@@ -82,16 +83,17 @@ impl PedestrianInput {
         frame_size_px: Option<(usize, usize)>,
         motion: &MotionParams,
         appearance: &AppearanceParams,
-        max_frames: Option<usize>,
+        frames: &FrameOptions,
         keep_colour: bool,
     ) -> Result<Self> {
+        let max_frames = frames.max_frames;
         let detections = detections.map(read_candidates).transpose()?;
+        let (start, options) = (frames.start_at, frames);
         let (frames, size, len, end) = match input {
             Some(input) => {
                 let options = FrameOptions {
                     colour: true,
-                    max_frames,
-                    ..FrameOptions::default()
+                    ..options.clone()
                 };
                 let frames = open_frames(input, &options)?;
                 let size = frames.dimensions();
@@ -112,7 +114,8 @@ impl PedestrianInput {
                 };
                 let last = found.keys().next_back().copied().unwrap_or(0) + 1;
                 let end = max_frames.map_or(last, |m| last.min(m as u64));
-                (None, size, Some(end as usize), end)
+                let end = options.stop_at.map_or(end, |stop| end.min(stop));
+                (None, size, Some(end.saturating_sub(start) as usize), end)
             }
         };
         // With frames, the motion detector gives the foreground mask of the likelihood, and
@@ -129,7 +132,7 @@ impl PedestrianInput {
             cues: FrameCues::default(),
             previous: None,
             keep_colour,
-            next_frame: 0,
+            next_frame: start,
             end_frame: end,
             frame_size_px: size,
             len,

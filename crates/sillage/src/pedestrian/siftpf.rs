@@ -55,20 +55,19 @@ impl SiftPfRun {
     }
 }
 
-/// Tracks the colour frames of `input` (the first `max_frames`); `on_frame` is called after
+/// Tracks the colour frames of `input` that `frames` selects; `on_frame` is called after
 /// each frame with the number of frames expected, when known (a progress bar's tick).
 pub fn track_siftpf(
     input: &str,
     settings: &SiftPfSettings,
     homography: Option<Homography>,
     seed: u64,
-    max_frames: Option<usize>,
+    frames: &FrameOptions,
     on_frame: &mut dyn FnMut(Option<usize>),
 ) -> Result<SiftPfRun> {
     let options = FrameOptions {
         colour: true,
-        max_frames,
-        ..FrameOptions::default()
+        ..frames.clone()
     };
     let mut frames = open_frames(input, &options)?;
     let (width, height) = frames.dimensions();

@@ -1,0 +1,198 @@
+"""A long sequence tracked in time windows on a Dask cluster, stitched into one set of
+trajectories.
+
+The sequence is cut into windows of ``window`` frames, consecutive ones sharing ``overlap``
+frames; each window is tracked on its own by a Dask worker (frames read by the worker from a
+path every worker sees, or sent from an array), and the windows' tracks are joined in order by
+the stitcher, which pairs the tracks of the overlap and renumbers identities globally (see
+``docs/scale.md``). The result depends on ``window``, ``overlap`` and ``seed``, never on the
+number of workers; it agrees with the single run of :func:`sillage.track` except for what a
+window's first frames cannot know (their warm-up), measured in ``docs/scale.md``.
+
+Needs ``dask`` and ``distributed``: ``pip install 'sillage[dask]'``. Progress shows on the
+Dask dashboard (``client.dashboard_link``).
+
+>>> from distributed import Client, LocalCluster
+>>> client = Client(LocalCluster(n_workers=8, threads_per_worker=1))
+>>> tracks = sillage.dask.track("/shared/run42/*.tif", "ptv", window=500, client=client)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Mapping
+
+import numpy as np
+import pandas as pd
+
+from . import _TRACKER_COLUMNS, _overrides, _path, _sillage
+
+__all__ = ["track", "DEFAULT_OVERLAP"]
+
+#: Frames shared by consecutive windows when ``overlap`` is not given (the command line's
+#: default; chosen on synthetic vortex flows, see ``docs/scale.md``).
+DEFAULT_OVERLAP: int = _sillage.DEFAULT_OVERLAP
+
+
+def track(source: str | os.PathLike | np.ndarray, tracker: str = "ptv", *, window: int,
+          overlap: int = DEFAULT_OVERLAP, client: Any = None, out: str | os.PathLike | None = None,
+          seed: int = 1, sequence_params: str | os.PathLike | None = None,
+          mask: str | os.PathLike | None = None, ground_plane: str | os.PathLike | None = None,
+          motion_prior: str | os.PathLike | None = None,
+          detections: str | os.PathLike | None = None, retries: int = 2,
+          params: Mapping[str, Any] | None = None, **keywords: Any) -> pd.DataFrame | list[str]:
+    """Tracks ``source`` in windows of ``window`` frames on the workers of ``client``.
+
+    ``source`` is a path every worker can read (a folder of images, a glob pattern, a
+    multi-page TIFF or a video whose frame count is known) or a numpy array of frames
+    ``(frames, rows, columns)`` (PTV and bedload; each window's frames are sent to its
+    worker). ``tracker``, ``seed``, the files and the keywords are those of
+    :func:`sillage.track`. ``overlap`` (at least 4, at most half the window) is the number of
+    frames consecutive windows share.
+
+    ``client`` is a ``distributed.Client``; without one, the current client is used, or a
+    ``LocalCluster`` on this machine is started for the call. A window whose task raised is
+    tried again up to ``retries`` times; a window whose worker died is rescheduled by Dask.
+
+    Returns the trajectories in the columns of :func:`sillage.track`, frame by frame; with
+    ``out`` (a folder), writes them instead as partitioned Parquet, ``part-00000.parquet``
+    onwards, one per window once its seam is stitched (needs pyarrow), and returns the paths.
+    The stitcher's report per seam is in ``tracks.attrs["seams"]`` (or, with ``out``, in
+    ``seams.json`` beside the parts).
+    """
+    try:
+        import distributed
+    except ImportError as error:
+        raise ImportError(
+            "sillage.dask needs dask and distributed: pip install 'sillage[dask]'") from error
+    if tracker not in _TRACKER_COLUMNS:
+        raise ValueError(f"unknown tracker `{tracker}`; choose one of {sorted(_TRACKER_COLUMNS)}")
+    overrides = _overrides(keywords, params, None if tracker == "ptv" else "tracker")
+    files = {name: _path(path) for name, path in [
+        ("sequence_params", sequence_params), ("mask", mask), ("ground_plane", ground_plane),
+        ("motion_prior", motion_prior), ("detections", detections)] if path is not None}
+    spec = (tracker, overrides, int(seed), files)
+    if isinstance(source, np.ndarray):
+        if source.ndim != 3:
+            raise ValueError(f"an array source holds frames (frames, rows, columns); got "
+                             f"{source.ndim} dimensions")
+        frames = len(source)
+    else:
+        source = _path(source)
+        frames = _sillage.frame_count(source)
+    windows = _sillage.plan_windows(frames, int(window), int(overlap), *spec)
+    if out is not None:
+        _require_pyarrow()
+
+    own_client = None
+    if client is None:
+        try:
+            client = distributed.get_client()
+        except ValueError:
+            own_client = client = distributed.Client(distributed.LocalCluster(processes=True))
+    try:
+        futures = _submit(client, source, spec, windows, retries)
+        return _stitch(distributed, futures, spec, out)
+    finally:
+        if own_client is not None:
+            own_client.close()
+            own_client.cluster.close()
+
+
+def _submit(client: Any, source: Any, spec: tuple, windows: list, retries: int) -> list:
+    """One task per window; an array's windows are scattered to the workers first."""
+    token = os.urandom(4).hex()
+    futures = []
+    first_frame = None
+    if isinstance(source, np.ndarray):
+        [first_frame] = client.scatter([np.ascontiguousarray(source[:1])])
+    for index, first, last in windows:
+        frames = source
+        if isinstance(source, np.ndarray):
+            [frames] = client.scatter([np.ascontiguousarray(source[first:last + 1])])
+        futures.append(client.submit(_track_window, frames, first_frame, spec, index, first,
+                                     last, key=f"sillage-window-{index}-{token}",
+                                     retries=retries, pure=False))
+    return futures
+
+
+def _track_window(frames: Any, first_frame: Any, spec: tuple, index: int, first: int,
+                  last: int) -> bytes:
+    """Runs on a worker: the window's tracks, as bytes, its kernels on the worker's threads."""
+    threads = _worker_threads()
+    if first_frame is not None:
+        return _sillage.track_window_frames(frames, first_frame, *spec, index, first, last,
+                                            threads)
+    return _sillage.track_window(frames, *spec, index, first, last, threads)
+
+
+def _worker_threads() -> int | None:
+    """The number of threads of the worker running this task (None outside a worker)."""
+    try:
+        from distributed import get_worker
+        worker = get_worker()
+    except (ImportError, ValueError):
+        return None
+    state = getattr(worker, "state", worker)
+    return int(getattr(state, "nthreads", 0)) or None
+
+
+def _stitch(distributed: Any, futures: list, spec: tuple, out: Any) -> pd.DataFrame | list[str]:
+    """Joins the windows in order as they finish; one DataFrame, or the Parquet parts."""
+    tracker = spec[0]
+    columns = _TRACKER_COLUMNS[tracker]
+    stitcher = _sillage.Stitcher(*spec)
+    position = {future.key: k for k, future in enumerate(futures)}
+    ready: dict[int, bytes] = {}
+    parts: list[pd.DataFrame] = []
+    paths: list[str] = []
+
+    def emit(batch: dict) -> None:
+        frame = pd.DataFrame(batch)[columns]
+        if out is None:
+            parts.append(frame)
+        elif len(frame):
+            path = os.path.join(os.fspath(out), f"part-{len(paths):05d}.parquet")
+            _write_atomically(frame, path)
+            paths.append(path)
+
+    if out is not None:
+        os.makedirs(out, exist_ok=True)
+    stitched = 0
+    for future in distributed.as_completed(futures):
+        ready[position[future.key]] = future.result()
+        future.release()
+        while stitched in ready:
+            emit(stitcher.push(ready.pop(stitched)))
+            stitched += 1
+    last, seams = stitcher.finish()
+    emit(last)
+    if out is not None:
+        _write_text(os.path.join(os.fspath(out), "seams.json"), seams)
+        return paths
+    tracks = pd.concat(parts, ignore_index=True)
+    tracks.attrs["seams"] = json.loads(seams)
+    return tracks
+
+
+def _require_pyarrow() -> None:
+    try:
+        import pyarrow  # noqa: F401
+    except ImportError as error:
+        raise ImportError("writing Parquet needs pyarrow: pip install pyarrow") from error
+
+
+def _write_atomically(frame: pd.DataFrame, path: str) -> None:
+    """Writes ``frame`` as Parquet under a temporary name, then renames it: a part is whole
+    or absent."""
+    partial = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.partial")
+    frame.to_parquet(partial, index=False)
+    os.replace(partial, path)
+
+
+def _write_text(path: str, text: str) -> None:
+    partial = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.partial")
+    with open(partial, "w", encoding="utf-8") as file:
+        file.write(text)
+    os.replace(partial, path)
