@@ -373,6 +373,17 @@ impl BlobDetector {
             None => image,
         };
         let measured = measure_particle_images(input)?;
+        self.calibrate_with(measured)
+    }
+
+    /// Takes `measured` (particle images measured on another detector's first frame: the
+    /// first frame of a sequence tracked in time windows) as its own measurement, so that
+    /// every window detects alike without measuring again; values given explicitly are kept.
+    /// Nothing changes once the scale and polarity are known.
+    pub fn calibrate_with(&mut self, measured: ParticleImages) -> Result<()> {
+        if self.resolved.is_some() {
+            return Ok(());
+        }
         let (scale, particle_sigma) = match self.params.scale_px {
             Scale::Px(scale) => (scale, None),
             Scale::Auto => (auto_scale_px(measured.sigma_px), Some(measured.sigma_px)),

@@ -8,7 +8,7 @@
 //! robust standard deviations of that scale's response); the polarity whose blobs stand out
 //! more (90th percentile of their significance) wins, and the measured σ is the median over its stronger half.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use sillage_core::{Error, GrayImage, Result};
 use sillage_image::{LogFilter, Polarity, median_mad};
 
@@ -30,7 +30,7 @@ const NOISE_FLOOR: f32 = 1e-3;
 const MAX_SIDE_PX: usize = 1024;
 
 /// What [`measure_particle_images`] found.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ParticleImages {
     /// Median std σ of the particle images, px (a Gaussian of this σ matches them).
     pub sigma_px: f64,

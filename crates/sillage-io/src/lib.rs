@@ -97,7 +97,7 @@ pub use mot::{
 pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
 pub use numeric_table::{ColumnValues, NumericFormat, NumericTable, write_numeric_table};
 pub use partial::PartialFile;
-pub use spool::{SpoolWriter, replay_spool, spool_path};
+pub use spool::{SpoolWriter, decode_points, encode_points, replay_spool, spool_path};
 pub use table_format::{TableFormat, detect_table_format};
 pub use tracks::{
     BackgroundWriter, QUEUED_BATCHES, STATE_COLUMNS, TRACK_COLUMNS, TRACTRAC_COLUMNS_LINE,

@@ -247,6 +247,32 @@ impl Decoder<'_> {
     }
 }
 
+/// Appends `points` to `out` in the spool's record form (a count, then the records): the
+/// compact form a time window's tracks travel in from a worker (about 100 bytes a PTV point).
+pub fn encode_points(points: &[TrackPoint], out: &mut Vec<u8>) {
+    out.extend_from_slice(&(points.len() as u64).to_le_bytes());
+    out.reserve(points.len() * (FIXED_LEN + 64));
+    for point in points {
+        encode(point, out);
+    }
+}
+
+/// The points [`encode_points`] wrote at the start of `bytes`, and the bytes after them;
+/// `None` when `bytes` do not hold such records.
+pub fn decode_points(bytes: &[u8]) -> Option<(Vec<TrackPoint>, &[u8])> {
+    let mut decoder = Decoder { bytes };
+    let count = usize::try_from(decoder.u64()?).ok()?;
+    // At least the fixed part per point must follow: no huge allocation for bad input.
+    if count > decoder.bytes.len() / FIXED_LEN {
+        return None;
+    }
+    let mut points = Vec::with_capacity(count);
+    for _ in 0..count {
+        points.push(decoder.point()?);
+    }
+    Some((points, decoder.bytes))
+}
+
 /// Replays the first `bytes` bytes of the spool at `path` into `sink`, batch by batch as
 /// they were accepted; returns the number of points.
 pub fn replay_spool(path: &Path, bytes: u64, sink: &mut dyn TrackSink) -> Result<u64> {

@@ -269,6 +269,7 @@ fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(experiments::bench_siftpf, module)?)?;
     module.add_function(wrap_pyfunction!(windows::frame_count, module)?)?;
     module.add_function(wrap_pyfunction!(windows::plan_windows, module)?)?;
+    module.add_function(wrap_pyfunction!(windows::measure_first_frames, module)?)?;
     module.add_function(wrap_pyfunction!(windows::track_window, module)?)?;
     module.add_function(wrap_pyfunction!(windows::track_window_frames, module)?)?;
     module.add_function(wrap_pyfunction!(windows::track_windows, module)?)?;

@@ -9,12 +9,13 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use sillage::Tracking;
-use sillage::core::{Error, TrackPoint};
+use sillage::core::TrackPoint;
 use sillage::io::FrameOptions;
 use sillage::track::stitch::Stitcher as WindowStitcher;
 use sillage::windows::{
-    Window, WindowPlan, WindowedRun, decode_window, encode_window, min_window, on_threads,
-    stitch_params, track_window as track_one_window, track_window_frames as track_array_window,
+    Measured, Window, WindowPlan, WindowedRun, decode_window, encode_window, min_window,
+    on_threads, stitch_params, track_window as track_one_window,
+    track_window_frames as track_array_window,
 };
 
 use crate::errors::to_py;
@@ -69,11 +70,51 @@ pub fn plan_windows(
         .collect())
 }
 
-/// Tracks window `index` (frames `first..=last`) of the frames at `source` with its kernels
-/// on `threads` threads (`None`: all cores); returns its tracks as bytes for
-/// [`Stitcher::push`].
+/// What a run decides on the first frames of `source` (a path, or frames as for `ptv`) and
+/// every window adopts, as JSON: measured once by the planner, for [`track_window`]'s
+/// `measured`.
 #[pyfunction]
-#[pyo3(signature = (source, tracker, overrides, seed, files, index, first, last, threads=None))]
+#[pyo3(signature = (source, tracker, overrides, seed, files))]
+pub fn measure_first_frames(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    tracker: &str,
+    overrides: Vec<String>,
+    seed: u64,
+    files: HashMap<String, PathBuf>,
+) -> PyResult<String> {
+    let tracking = tracking_of(tracker, &overrides, seed, files)?;
+    let measured = if let Ok(path) = source.extract::<String>() {
+        py.detach(|| Measured::on_source(&path, &tracking))
+    } else {
+        let Tracking::Pipeline(config) = &tracking else {
+            return to_json(&Measured::default());
+        };
+        let arrays = FrameArrays::borrow(source)?;
+        let views = arrays.views()?;
+        py.detach(|| Measured::on_frames(config, || Ok(frames_of(&views))))
+    }
+    .map_err(to_py)?;
+    to_json(&measured)
+}
+
+/// The decisions of [`measure_first_frames`]' JSON (none: each window decides its own).
+fn measured_of(measured: Option<String>) -> PyResult<Measured> {
+    measured.map_or(Ok(Measured::default()), |json| {
+        serde_json::from_str(&json).map_err(|e| {
+            PyValueError::new_err(format!(
+                "measured is not what measure_first_frames returned: {e}"
+            ))
+        })
+    })
+}
+
+/// Tracks window `index` (frames `first..=last`) of the frames at `source` with its kernels
+/// on `threads` threads (`None`: all cores), adopting the decisions `measured` of
+/// [`measure_first_frames`]; returns its tracks as bytes for [`Stitcher::push`].
+#[pyfunction]
+#[pyo3(signature = (source, tracker, overrides, seed, files, index, first, last,
+    measured=None, threads=None))]
 #[allow(clippy::too_many_arguments)] // one argument each, as Python passes them
 pub fn track_window<'py>(
     py: Python<'py>,
@@ -85,30 +126,32 @@ pub fn track_window<'py>(
     index: usize,
     first: u64,
     last: u64,
+    measured: Option<String>,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let tracking = tracking_of(tracker, &overrides, seed, files)?;
+    let measured = measured_of(measured)?;
     let window = Window { index, first, last };
     let bytes = py
         .detach(|| {
-            on_threads(threads, || track_one_window(&source, &tracking, &window))
-                .and_then(|tracks| encode_window(&tracks))
+            on_threads(threads, || {
+                track_one_window(&source, &tracking, &window, &measured)
+            })
+            .map(|tracks| encode_window(&tracks))
         })
         .map_err(to_py)?;
     Ok(PyBytes::new(py, &bytes))
 }
 
 /// [`track_window`] on frames held in memory (PTV and bedload): `frames` are the window's
-/// frames `first..=last`, `first_frame` the sequence's first frame (where an `"auto"` blob
-/// scale is measured, as for files).
+/// frames `first..=last`.
 #[pyfunction]
-#[pyo3(signature = (frames, first_frame, tracker, overrides, seed, files, index, first, last,
-    threads=None))]
+#[pyo3(signature = (frames, tracker, overrides, seed, files, index, first, last,
+    measured=None, threads=None))]
 #[allow(clippy::too_many_arguments)] // one argument each, as Python passes them
 pub fn track_window_frames<'py>(
     py: Python<'py>,
     frames: &Bound<'py, PyAny>,
-    first_frame: &Bound<'py, PyAny>,
     tracker: &str,
     overrides: Vec<String>,
     seed: u64,
@@ -116,19 +159,18 @@ pub fn track_window_frames<'py>(
     index: usize,
     first: u64,
     last: u64,
+    measured: Option<String>,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyBytes>> {
+    let measured = measured_of(measured)?;
     let Tracking::Pipeline(config) = tracking_of(tracker, &overrides, seed, files)? else {
         return Err(PyValueError::new_err(format!(
             "frames in memory are tracked by ptv and bedload only; give the pedestrian \
              trackers (`{tracker}`) a path"
         )));
     };
-    let (arrays, first_arrays) = (
-        FrameArrays::borrow(frames)?,
-        FrameArrays::borrow(first_frame)?,
-    );
-    let (views, first_views) = (arrays.views()?, first_arrays.views()?);
+    let arrays = FrameArrays::borrow(frames)?;
+    let views = arrays.views()?;
     if views.len() as u64 != last - first + 1 {
         return Err(PyValueError::new_err(format!(
             "window {index} spans frames {first}–{last} but {} frames were given",
@@ -138,9 +180,6 @@ pub fn track_window_frames<'py>(
     let window = Window { index, first, last };
     let bytes = py
         .detach(|| {
-            let first_frame = frames_of(&first_views)
-                .next()
-                .ok_or_else(|| Error::input("first_frame holds no frame"))??;
             let frames = || {
                 frames_of(&views).map(move |frame| {
                     frame.map(|mut frame| {
@@ -150,9 +189,9 @@ pub fn track_window_frames<'py>(
                 })
             };
             on_threads(threads, || {
-                track_array_window(&config, &window, &first_frame, frames)
+                track_array_window(&config, &window, &measured, frames)
             })
-            .and_then(|tracks| encode_window(&tracks))
+            .map(|tracks| encode_window(&tracks))
         })
         .map_err(to_py)?;
     Ok(PyBytes::new(py, &bytes))

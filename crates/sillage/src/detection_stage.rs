@@ -6,7 +6,7 @@
 use sillage_core::{Detection, Detector, Error, GrayImage, Result};
 use sillage_detect::Preprocessor;
 use sillage_detect::blob::{BlobDetector, Calibration};
-use sillage_detect::{BeadDetections, BeadDetector};
+use sillage_detect::{BeadDetections, BeadDetector, ParticleImages};
 use sillage_io::Frame;
 
 use crate::bedload::detector::detect_frame;
@@ -155,6 +155,16 @@ impl DetectionStage {
         detector
             .calibrate(image)
             .map_err(|e| Error::frame(&frame.path, frame.index, e.to_string()))
+    }
+
+    /// Adopts particle images measured on another run's first frame (see
+    /// [`BlobDetector::calibrate_with`](sillage_detect::blob::BlobDetector::calibrate_with));
+    /// nothing to do for other detectors.
+    pub fn calibrate_with(&mut self, measured: ParticleImages) -> Result<()> {
+        match &mut self.detector {
+            AnyDetector::Blob(detector) => detector.calibrate_with(measured),
+            AnyDetector::Bead(..) => Ok(()),
+        }
     }
 
     /// The blob detector's scale and polarity in use and what was measured to choose them

@@ -6,8 +6,8 @@ use sillage_core::{
     Detection, DiscardSink, Error, FrameIndex, FrameObservations, Result, TrackPoint, TrackSink,
     Tracker,
 };
-use sillage_detect::Preprocessor;
 use sillage_detect::blob::Calibration;
+use sillage_detect::{ParticleImages, Preprocessor};
 use sillage_io::Frame;
 use sillage_track::bedload::{BedloadStats, BedloadTracker};
 use sillage_track::ptv::{PassDirection, PtvTracker};
@@ -247,6 +247,22 @@ impl Pipeline {
     /// detected is measured.
     pub fn calibrate(&mut self, frame: &Frame) -> Result<()> {
         self.stage.calibrate(frame)
+    }
+
+    /// Adopts particle images measured on another run's first frame instead of measuring
+    /// (the windows of one sequence, see [`crate::windows`]).
+    pub fn calibrate_with(&mut self, measured: ParticleImages) -> Result<()> {
+        self.stage.calibrate_with(measured)
+    }
+
+    /// PTV with `vote_search_px = "auto"`: links the first frames as the automatic decision
+    /// does, then follows `radius` (voting on with it, or off for `None`) decided on another
+    /// run's first frames (see `PtvTracker::follow_vote_decision`); nothing for the bedload
+    /// trackers.
+    pub fn follow_vote_decision(&mut self, radius: Option<f64>) {
+        if let AnyTracker::Ptv(tracker) = &mut self.tracker {
+            tracker.follow_vote_decision(radius);
+        }
     }
 
     /// The blob detector's scale and polarity in use and what was measured to choose them.

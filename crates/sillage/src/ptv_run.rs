@@ -6,8 +6,8 @@ use std::path::Path;
 
 use sillage_core::{Error, FrameIndex, Result, TrackSink};
 use sillage_io::{
-    BadFramePolicy, FrameOptions, SkippedFrame, TrackFileHeader, TrackFormat, WrittenSummary,
-    create_track_writer, open_frames, read_tractrac_par,
+    BadFramePolicy, FrameOptions, SkippedFrame, TrackFileHeader, TrackFormat, TrackWriter,
+    WrittenSummary, create_track_writer, open_frames, read_tractrac_par, write_in_background,
 };
 
 use sillage_detect::blob::Calibration;
@@ -19,7 +19,7 @@ use crate::pipeline::{FrameInput, FrameReport, Pipeline, RunSummary};
 use crate::toml_config::{Settings, dotted_keys, load_unvalidated, set_key};
 use crate::tracking::Tracking;
 use crate::tractrac::apply_par;
-use crate::windows::{Window, WindowPlan, WindowedRun, WindowedSummary};
+use crate::windows::{Measured, Window, WindowPlan, WindowedRun, WindowedSummary};
 
 impl Settings for PipelineConfig {
     fn validate(&self) -> Result<()> {
@@ -127,14 +127,21 @@ impl PtvRun {
             on_bad_frame,
             ..FrameOptions::default()
         };
-        Self::open_frames(config, input, frames)
+        Self::open_frames(config, input, frames, &Measured::default())
     }
 
     /// [`PtvRun::open`] on the frames `frames` selects (a time window: its `start_at`,
     /// `stop_at`, `max_frames`; its bad-frame policy). The background model starts from the
-    /// selected frames; an `"auto"` blob scale or polarity is measured on the sequence's first
-    /// frame, whatever the selection, so that every window of a run detects alike.
-    pub fn open_frames(config: &PipelineConfig, input: &str, frames: FrameOptions) -> Result<Self> {
+    /// selected frames. What a run decides on its first frames is taken from `measured`
+    /// (decided by a windowed run's planner on the sequence's first frames, see
+    /// [`Measured`]); an `"auto"` blob scale or polarity not given there is measured here on
+    /// the sequence's first frame, whatever the selection, so that every window detects alike.
+    pub fn open_frames(
+        config: &PipelineConfig,
+        input: &str,
+        frames: FrameOptions,
+        measured: &Measured,
+    ) -> Result<Self> {
         let mut pipeline = Pipeline::from_config(config)?;
         let background_frames = if pipeline.background_init_frames() > 0 {
             Some(pipeline.prime_background(open_frames(input, &frames)?)?)
@@ -142,7 +149,10 @@ impl PtvRun {
             None
         };
         let frame_count = open_frames(input, &frames)?.len();
-        if let DetectorConfig::Blob(_) = config.detector {
+        measured.adopt(&mut pipeline)?;
+        if let DetectorConfig::Blob(_) = config.detector
+            && pipeline.calibration().is_none()
+        {
             let first_frame = FrameOptions {
                 on_bad_frame: frames.on_bad_frame,
                 ..FrameOptions::default()
@@ -290,10 +300,11 @@ impl PtvRun {
             ));
         }
         let tracking = Tracking::Pipeline(Box::new(self.config));
-        let mut writer = create_track_writer(out, format, &self.header)?;
+        // Formatting rows takes a core's share: on a thread of its own, as in a single run.
+        let mut writer = write_in_background(create_track_writer(out, format, &self.header)?)?;
         let run = WindowedRun::new(&tracking, plan).jobs(jobs);
-        let summary = run.run(&self.input, &mut *writer, on_window);
-        let written = writer.finish()?;
+        let summary = run.run(&self.input, &mut writer, on_window);
+        let written = Box::new(writer).finish()?;
         Ok((summary?, written))
     }
 }

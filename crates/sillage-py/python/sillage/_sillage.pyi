@@ -91,13 +91,16 @@ def plan_windows(
     frames: int, window: int, overlap: int, tracker: str, overrides: list[str], seed: int,
     files: Files,
 ) -> list[Window]: ...
+def measure_first_frames(
+    source: Any, tracker: str, overrides: list[str], seed: int, files: Files,
+) -> str: ...
 def track_window(
     source: str, tracker: str, overrides: list[str], seed: int, files: Files, index: int,
-    first: int, last: int, threads: Optional[int] = None,
+    first: int, last: int, measured: Optional[str] = None, threads: Optional[int] = None,
 ) -> bytes: ...
 def track_window_frames(
-    frames: np.ndarray, first_frame: np.ndarray, tracker: str, overrides: list[str],
-    seed: int, files: Files, index: int, first: int, last: int,
+    frames: np.ndarray, tracker: str, overrides: list[str], seed: int, files: Files,
+    index: int, first: int, last: int, measured: Optional[str] = None,
     threads: Optional[int] = None,
 ) -> bytes: ...
 def track_windows(

@@ -84,6 +84,9 @@ def track(source: str | os.PathLike | np.ndarray, tracker: str = "ptv", *, windo
     windows = _sillage.plan_windows(frames, int(window), int(overlap), *spec)
     if out is not None:
         _require_pyarrow()
+    # Decided once here, on the sequence's first frames, so that every window detects and
+    # links alike (particle size and polarity, PTV's displacement voting).
+    measured = _sillage.measure_first_frames(source, *spec)
 
     own_client = None
     if client is None:
@@ -92,7 +95,7 @@ def track(source: str | os.PathLike | np.ndarray, tracker: str = "ptv", *, windo
         except ValueError:
             own_client = client = distributed.Client(distributed.LocalCluster(processes=True))
     try:
-        futures = _submit(client, source, spec, windows, retries)
+        futures = _submit(client, source, spec, measured, windows, retries)
         return _stitch(distributed, futures, spec, out)
     finally:
         if own_client is not None:
@@ -100,31 +103,27 @@ def track(source: str | os.PathLike | np.ndarray, tracker: str = "ptv", *, windo
             own_client.cluster.close()
 
 
-def _submit(client: Any, source: Any, spec: tuple, windows: list, retries: int) -> list:
+def _submit(client: Any, source: Any, spec: tuple, measured: str, windows: list,
+            retries: int) -> list:
     """One task per window; an array's windows are scattered to the workers first."""
     token = os.urandom(4).hex()
     futures = []
-    first_frame = None
-    if isinstance(source, np.ndarray):
-        [first_frame] = client.scatter([np.ascontiguousarray(source[:1])])
     for index, first, last in windows:
         frames = source
         if isinstance(source, np.ndarray):
             [frames] = client.scatter([np.ascontiguousarray(source[first:last + 1])])
-        futures.append(client.submit(_track_window, frames, first_frame, spec, index, first,
+        futures.append(client.submit(_track_window, frames, spec, measured, index, first,
                                      last, key=f"sillage-window-{index}-{token}",
                                      retries=retries, pure=False))
     return futures
 
 
-def _track_window(frames: Any, first_frame: Any, spec: tuple, index: int, first: int,
+def _track_window(frames: Any, spec: tuple, measured: str, index: int, first: int,
                   last: int) -> bytes:
     """Runs on a worker: the window's tracks, as bytes, its kernels on the worker's threads."""
     threads = _worker_threads()
-    if first_frame is not None:
-        return _sillage.track_window_frames(frames, first_frame, *spec, index, first, last,
-                                            threads)
-    return _sillage.track_window(frames, *spec, index, first, last, threads)
+    track = _sillage.track_window if isinstance(frames, str) else _sillage.track_window_frames
+    return track(frames, *spec, index, first, last, measured, threads)
 
 
 def _worker_threads() -> int | None:
@@ -145,16 +144,15 @@ def _stitch(distributed: Any, futures: list, spec: tuple, out: Any) -> pd.DataFr
     stitcher = _sillage.Stitcher(*spec)
     position = {future.key: k for k, future in enumerate(futures)}
     ready: dict[int, bytes] = {}
-    parts: list[pd.DataFrame] = []
+    parts: list[dict] = []
     paths: list[str] = []
 
     def emit(batch: dict) -> None:
-        frame = pd.DataFrame(batch)[columns]
         if out is None:
-            parts.append(frame)
-        elif len(frame):
+            parts.append(batch)
+        elif len(batch["frame"]):
             path = os.path.join(os.fspath(out), f"part-{len(paths):05d}.parquet")
-            _write_atomically(frame, path)
+            _write_atomically(pd.DataFrame(batch)[columns], path)
             paths.append(path)
 
     if out is not None:
@@ -171,7 +169,9 @@ def _stitch(distributed: Any, futures: list, spec: tuple, out: Any) -> pd.DataFr
     if out is not None:
         _write_text(os.path.join(os.fspath(out), "seams.json"), seams)
         return paths
-    tracks = pd.concat(parts, ignore_index=True)
+    # One copy of each column into the DataFrame, rather than one per window then a concat.
+    tracks = pd.DataFrame({name: np.concatenate([part[name] for part in parts])
+                           for name in columns})
     tracks.attrs["seams"] = json.loads(seams)
     return tracks
 

@@ -140,6 +140,10 @@ pub struct PtvTracker {
     /// automatic decision waits for the first two frames.
     vote_radius: Option<f64>,
     vote_decided: bool,
+    /// An automatic decision taken elsewhere that this tracker follows (a time window of a
+    /// longer run: `Some(radius)`, or `None` for off), see [`PtvTracker::follow_vote_decision`].
+    #[serde(default)]
+    followed_decision: Option<Option<f64>>,
     /// The displacement (95th percentile, px) the automatic decision measured.
     measured_displacement: Option<f64>,
     forward: Vec<Option<Neighbour>>,
@@ -192,6 +196,7 @@ impl PtvTracker {
                 VoteSearch::Mode(_) => None,
             },
             vote_decided: vote != VoteSearch::Mode(VoteMode::Auto),
+            followed_decision: None,
             measured_displacement: None,
             forward: Vec::new(),
             two_nearest: Vec::new(),
@@ -214,6 +219,14 @@ impl PtvTracker {
     /// Voting's search radius in use (`None`: off, or an automatic decision not yet made).
     pub fn vote_radius(&self) -> Option<f64> {
         self.vote_radius
+    }
+
+    /// With `vote_search_px = "auto"`, links its first two frames as the automatic decision
+    /// does (a vote from rest) but then follows `radius` (`Some`: voting on with that search
+    /// radius; `None`: off) instead of deciding: a time window of a run whose decision was
+    /// taken on the run's first frames, so that every window links as that run does.
+    pub fn follow_vote_decision(&mut self, radius: Option<f64>) {
+        self.followed_decision = Some(radius);
     }
 
     /// The displacement an automatic voting decision measured on the first two frames (95th
@@ -340,6 +353,7 @@ impl PtvTracker {
             vote = self.vote_from_rest(far_radius);
         }
         let Some(vote) = vote else {
+            self.vote_radius = self.followed_decision.flatten();
             return;
         };
         let p95 = percentile_norm(&self.voted, 0.95);
@@ -349,9 +363,12 @@ impl PtvTracker {
             self.displacements.resize(self.c1.len(), Vec2::ZERO);
             self.apply_votes(&vote, false, dt);
         }
-        if p95 >= AUTO_VOTE_SPACINGS * spacing {
-            self.vote_radius = Some((AUTO_VOTE_MARGIN * p95).max(1.0));
-        }
+        self.vote_radius = match self.followed_decision {
+            Some(radius) => radius,
+            None => {
+                (p95 >= AUTO_VOTE_SPACINGS * spacing).then(|| (AUTO_VOTE_MARGIN * p95).max(1.0))
+            }
+        };
     }
 
     /// The displacements voted from zero motion within `radius` px, into `self.voted`.

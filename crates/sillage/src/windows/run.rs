@@ -8,7 +8,7 @@ use serde::Serialize;
 use sillage_core::{Result, TrackSink};
 use sillage_track::stitch::{SeamReport, StitchParams, Stitcher, WindowTracks};
 
-use super::{Window, WindowPlan, on_threads, stitch_params, track_window};
+use super::{Measured, Window, WindowPlan, on_threads, stitch_params, track_window};
 use crate::tracking::Tracking;
 
 /// What a windowed run did.
@@ -49,7 +49,7 @@ impl<'a> WindowedRun<'a> {
     }
 
     /// Runs `jobs` windows at once (at least 1), each on its share of the cores for its
-    /// parallel kernels.
+    /// parallel kernels (the last windows, fewer than `jobs`, on a larger share).
     pub fn jobs(mut self, jobs: usize) -> Self {
         self.jobs = jobs.max(1);
         self
@@ -73,10 +73,10 @@ impl<'a> WindowedRun<'a> {
         let windows = self.plan.windows();
         let jobs = self.jobs.min(windows.len());
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let threads = (cores / jobs).max(1);
         let next = AtomicUsize::new(0);
         let stop = AtomicBool::new(false);
         let mut stitcher = Stitcher::new(self.stitch)?;
+        let measured = Measured::on_source(source, self.tracking)?;
         let mut points = 0u64;
         std::thread::scope(|scope| -> Result<()> {
             let (sender, receiver) = mpsc::channel();
@@ -89,8 +89,12 @@ impl<'a> WindowedRun<'a> {
                         if k >= windows.len() || stop.load(Ordering::SeqCst) {
                             return;
                         }
+                        // The cores shared by the windows still running: the last ones get
+                        // more when fewer windows than jobs remain.
+                        let running = jobs.min(windows.len() - k);
+                        let threads = (cores / running).max(1);
                         let tracked = on_threads(Some(threads), || {
-                            track_window(source, self.tracking, &windows[k])
+                            track_window(source, self.tracking, &windows[k], &measured)
                         });
                         if sender.send((k, tracked)).is_err() {
                             return;

@@ -1,0 +1,77 @@
+"""Time windows on Dask: one sequence tracked by ``sillage.dask.track`` on a LocalCluster of 1
+and of 2 single-threaded workers, and by the single run, in one run of this script.
+
+    python benches/python/bench_dask_windows.py FRAMES_FOLDER [--window 100] [--overlap 16]
+
+FRAMES_FOLDER is a sequence on disk, e.g. 400 frames of the vortex on 2048 x 2048 px:
+``sillage synth vortex --out /tmp/v2048 --frames 400 --particles 25000 --width 2048
+--height 2048 --seed 3``. Prints the wall times, the speed-up of 2 workers over 1, the
+windowed runs against the single run (all cores, one process), and how far the stitched
+trajectories agree with the single run's (points present, seam-crossing identities kept).
+"""
+
+import argparse
+import os
+import platform
+import time
+
+import pandas as pd
+from distributed import Client, LocalCluster
+
+import sillage
+
+
+def timed(function):
+    start = time.perf_counter()
+    result = function()
+    return time.perf_counter() - start, result
+
+
+def agreement(single, stitched, cuts):
+    """Share of the single run's points present (same frame and position) and share of its
+    seam-crossing trajectories whose points keep one identity."""
+    keys = ["frame", "x", "y"]
+    merged = single.merge(stitched[keys + ["particle"]], on=keys, how="left",
+                          suffixes=("", "_stitched"))
+    present = merged["particle_stitched"].notna().mean()
+    spans = single.groupby("particle")["frame"].agg(["min", "max"])
+    crossing = spans[[any(lo < cut <= hi for cut in cuts)
+                      for lo, hi in zip(spans["min"], spans["max"])]].index
+    ids = merged[merged["particle"].isin(crossing)].dropna(subset=["particle_stitched"])
+    kept = (ids.groupby("particle")["particle_stitched"].nunique() == 1).mean()
+    return present, kept, len(crossing)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("frames")
+    parser.add_argument("--window", type=int, default=100)
+    parser.add_argument("--overlap", type=int, default=16)
+    args = parser.parse_args()
+    print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+          f"sillage {sillage.__version__}, {args.frames}, window {args.window}, "
+          f"overlap {args.overlap}")
+
+    single_s, single = timed(lambda: sillage.track(args.frames))
+    print(f"single run (one process, all cores): {single_s:.2f} s, {len(single)} points")
+    runs = {}
+    for workers in (1, 2):
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                          dashboard_address=":0") as cluster, Client(cluster) as client:
+            client.wait_for_workers(workers)
+            seconds, tracks = timed(lambda: sillage.dask.track(
+                args.frames, window=args.window, overlap=args.overlap, client=client))
+        runs[workers] = (seconds, tracks)
+        print(f"dask, {workers} worker(s) x 1 thread: {seconds:.2f} s, {len(tracks)} points")
+    (one_s, one), (two_s, two) = runs[1], runs[2]
+    pd.testing.assert_frame_equal(one, two)
+    print(f"speed-up of 2 workers over 1: {one_s / two_s:.2f}x; "
+          f"2 workers against the single run: {single_s / two_s:.2f}x")
+    cuts = [seam["cut"] for seam in two.attrs["seams"]]
+    present, kept, crossing = agreement(single, two, cuts)
+    print(f"against the single run: {100 * present:.4f} % of its points present, "
+          f"{100 * kept:.3f} % of {crossing} seam-crossing trajectories keep one identity")
+
+
+if __name__ == "__main__":
+    main()
