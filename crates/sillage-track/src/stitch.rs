@@ -15,10 +15,11 @@
 //! earlier window's identity, and takes its partner's point where it has none on its own side
 //! of the cut; the points an unpaired track has on the other side of the cut are kept unless
 //! the other window has a point within [`StitchParams::same_px`] in that frame (the overlap's
-//! duplicates). Identities are renumbered globally, in order of the
+//! duplicates). A track of the later window that ends before the cut lived only in that
+//! window's warm-up and is dropped. Identities are renumbered globally, in order of the
 //! windows and, within one, of the window's own ids.
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
 use serde::{Deserialize, Serialize};
 use sillage_assoc::{Pairing, PointIndex, SparseLapSolver};
@@ -87,6 +88,9 @@ pub struct SeamReport {
     pub identical: usize,
     /// Points of unpaired tracks dropped as duplicates of the other window's.
     pub duplicates: usize,
+    /// Points of the later window's tracks that ended before the cut, dropped as its
+    /// warm-up.
+    pub warm_up: usize,
 }
 
 /// Joins windows pushed in order, handing back the points that became final.
@@ -294,17 +298,25 @@ impl Stitcher {
                 report.duplicates += 1;
             }
         }
-        // The later window's points before the cut: the same rule the other way round.
+        // The later window's points before the cut: the same rule the other way round, for
+        // tracks that go on past the cut; a track that ends before it lived only in the
+        // window's warm-up (a detector's background still learning, a motion model still
+        // empty) and is dropped.
         let later_cut = later.partition_point(|p| p.frame < cut);
+        let goes_on: HashSet<TrackId> = later[later_cut..].iter().map(|p| p.track_id).collect();
         let mut later_head = Vec::new();
         for p in later.drain(..later_cut) {
             let keep = match joined.get(&p.track_id) {
                 Some((partner, _)) => !has_point(&earlier_tracks, *partner, p.frame),
+                None if !goes_on.contains(&p.track_id) => {
+                    report.warm_up += 1;
+                    false
+                }
                 None => !duplicate(&earlier_frames, &p),
             };
             if keep {
                 later_head.push(p);
-            } else if !joined.contains_key(&p.track_id) {
+            } else if !joined.contains_key(&p.track_id) && goes_on.contains(&p.track_id) {
                 report.duplicates += 1;
             }
         }
@@ -651,12 +663,18 @@ mod tests {
     fn unpaired_tracks_keep_their_points_without_duplicates() {
         // The later window lost the track at 50 px, which ends in the overlap at frame 17;
         // the earlier lost the one at 90 px, which starts at frame 13 in the later window.
+        // A track of the later window's warm-up (frames 11–13, before the cut) is dropped.
         let earlier = window(0, 19, vec![track(0, 1, 17, 0.0, 50.0)]);
-        let later = window(10, 29, vec![track(0, 13, 28, 0.0, 90.0)]);
+        let later = window(
+            10,
+            29,
+            vec![track(0, 13, 28, 0.0, 90.0), track(1, 11, 13, 0.0, 130.0)],
+        );
         let (points, seams) = stitch([earlier, later], StitchParams::default()).unwrap();
         assert_eq!(points.iter().filter(|p| p.pos_px.y == 50.0).count(), 17);
         assert_eq!(points.iter().filter(|p| p.pos_px.y == 90.0).count(), 16);
-        assert_eq!(seams[0].joined, 0);
+        assert!(!points.iter().any(|p| p.pos_px.y == 130.0));
+        assert_eq!((seams[0].joined, seams[0].warm_up), (0, 3));
         // An unpaired track's points that the other window also has are dropped once.
         let earlier = window(
             0,

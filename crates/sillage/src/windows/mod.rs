@@ -196,21 +196,36 @@ pub fn min_window(tracking: &Tracking) -> usize {
     }
 }
 
-/// How the stitcher joins `tracking`'s windows: PTV's windows see identical detections, so
-/// tracks join at (near) zero distance; the particle filters' estimates differ between windows
-/// by their random draws (bedload: 3 px, a fifth of a bead's radius; pedestrians: 10 px, a
-/// fifth of a person's width at PETS 2009's scale). Set before measuring, not tuned.
+/// Frames a window of `tracking` is run for before its first frame, its output there dropped:
+/// the pedestrian trackers' motion detector learns its background over its start-up phase
+/// (`bootstrap_frames`, 20 for the IMM-PF), and a window starting with it empty reports the
+/// people standing in its first frame as ghosts. PTV and the bedload trackers start from their
+/// first frames (their warm-up is a few frames, inside the overlap).
+pub fn lead_in(tracking: &Tracking) -> u64 {
+    let mixture = match tracking {
+        Tracking::Pipeline(_) => return 0,
+        Tracking::Immpf(setup) => &setup.settings.motion_detector.detector.mixture,
+        Tracking::Siftpf(setup) => &setup.settings.motion_detector.mixture,
+    };
+    mixture.bootstrap_frames as u64
+}
+
+/// How the stitcher joins `tracking`'s windows. PTV's windows see identical detections: tracks
+/// join within 1 px and a point is a duplicate within 0.01 px. The particle filters' estimates
+/// of one object differ between windows by their random draws, so both distances are one
+/// radius of agreement: 3 px for beads (a fifth of a bead's radius), 15 px for people (half a
+/// person's width at PETS 2009's scale). Set before measuring, not tuned.
 pub fn stitch_params(tracking: &Tracking) -> StitchParams {
-    let join_px = match tracking {
+    let agree_px = match tracking {
         Tracking::Pipeline(config) => match config.tracker {
-            TrackerConfig::Ptv(_) => 1.0,
+            TrackerConfig::Ptv(_) => return StitchParams::default(),
             TrackerConfig::Bedload(_) => 3.0,
         },
-        Tracking::Immpf(_) | Tracking::Siftpf(_) => 10.0,
+        Tracking::Immpf(_) | Tracking::Siftpf(_) => 15.0,
     };
     StitchParams {
-        join_px,
-        ..StitchParams::default()
+        same_px: agree_px,
+        join_px: agree_px,
     }
 }
 
@@ -260,13 +275,14 @@ pub fn track_window(
                 .run(&mut points, &mut |_| {})?;
         }
         pedestrians => {
-            track_source(
-                source,
-                &pedestrians,
-                &window.frame_options(),
-                &mut points,
-                &mut || {},
-            )?;
+            // The motion detector's background learns from a lead-in before the window;
+            // what the tracker reports there is dropped.
+            let frames = FrameOptions {
+                start_at: window.first.saturating_sub(lead_in(&pedestrians)),
+                ..window.frame_options()
+            };
+            track_source(source, &pedestrians, &frames, &mut points, &mut || {})?;
+            points.retain(|p| p.frame >= window.first);
         }
     }
     Ok(WindowTracks {
