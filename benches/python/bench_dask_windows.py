@@ -27,21 +27,6 @@ def timed(function):
     return time.perf_counter() - start, result
 
 
-def agreement(single, stitched, cuts):
-    """Share of the single run's points present (same frame and position) and share of its
-    seam-crossing trajectories whose points keep one identity."""
-    keys = ["frame", "x", "y"]
-    merged = single.merge(stitched[keys + ["particle"]], on=keys, how="left",
-                          suffixes=("", "_stitched"))
-    present = merged["particle_stitched"].notna().mean()
-    spans = single.groupby("particle")["frame"].agg(["min", "max"])
-    crossing = spans[[any(lo < cut <= hi for cut in cuts)
-                      for lo, hi in zip(spans["min"], spans["max"])]].index
-    ids = merged[merged["particle"].isin(crossing)].dropna(subset=["particle_stitched"])
-    kept = (ids.groupby("particle")["particle_stitched"].nunique() == 1).mean()
-    return present, kept, len(crossing)
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("frames")
@@ -67,10 +52,10 @@ def main():
     pd.testing.assert_frame_equal(one, two)
     print(f"speed-up of 2 workers over 1: {one_s / two_s:.2f}x; "
           f"2 workers against the single run: {single_s / two_s:.2f}x")
-    cuts = [seam["cut"] for seam in two.attrs["seams"]]
-    present, kept, crossing = agreement(single, two, cuts)
-    print(f"against the single run: {100 * present:.4f} % of its points present, "
-          f"{100 * kept:.3f} % of {crossing} seam-crossing trajectories keep one identity")
+    agreed = sillage.dask.agreement(single, two)
+    print(f"against the single run: {100 * agreed['points']:.4f} % of its points present, "
+          f"{100 * agreed['identities']:.3f} % of {agreed['crossing']} seam-crossing "
+          f"trajectories keep one identity")
 
 
 if __name__ == "__main__":

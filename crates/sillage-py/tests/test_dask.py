@@ -35,32 +35,17 @@ def client():
         yield client
 
 
-def agreement(single: pd.DataFrame, stitched: pd.DataFrame, cuts: list) -> tuple:
-    """Share of the single run's points present (same frame and position) and share of its
-    trajectories crossing a cut whose points carry one identity in the stitched run."""
-    keys = ["frame", "x", "y"]
-    merged = single.merge(stitched[keys + ["particle"]], on=keys, how="left",
-                          suffixes=("", "_stitched"))
-    present = merged["particle_stitched"].notna().mean()
-    spans = single.groupby("particle")["frame"].agg(["min", "max"])
-    crossing = spans[[any(lo < cut <= hi for cut in cuts)
-                      for lo, hi in zip(spans["min"], spans["max"])]].index
-    ids = merged[merged["particle"].isin(crossing)].dropna(subset=["particle_stitched"])
-    kept = (ids.groupby("particle")["particle_stitched"].nunique() == 1).mean()
-    return present, kept, len(crossing)
-
-
 def test_dask_matches_the_local_runner_and_the_single_run(sequence, client):
     folder, frames = sequence
     single = sillage.track(folder)
     local = sillage.track(folder, window=WINDOW, overlap=OVERLAP, jobs=2)
     distributed = sillage.dask.track(folder, window=WINDOW, overlap=OVERLAP, client=client)
     pd.testing.assert_frame_equal(distributed, local)
-    cuts = [seam["cut"] for seam in distributed.attrs["seams"]]
-    assert len(cuts) == 3
-    present, kept, crossing = agreement(single, distributed, cuts)
-    print(f"{100 * present:.3f} % of the points, {100 * kept:.2f} % of {crossing} crossing "
-          f"trajectories keep one identity")
+    assert len(distributed.attrs["seams"]) == 3
+    agreed = sillage.dask.agreement(single, distributed)
+    present, kept = agreed["points"], agreed["identities"]
+    print(f"{100 * present:.3f} % of the points, {100 * kept:.2f} % of {agreed['crossing']} "
+          f"crossing trajectories keep one identity")
     # The Rust test (tests/windows.rs) asserts the acceptance (99.9 %, 99 %) on 2,225
     # crossing trajectories; here 1 % is a handful of tracks, so 98 % is required.
     assert present >= 0.999
@@ -72,10 +57,9 @@ def test_dask_tracks_an_array_sent_to_the_workers(sequence, client):
     _, frames = sequence
     single = sillage.ptv(frames)
     distributed = sillage.dask.track(frames, window=WINDOW, overlap=OVERLAP, client=client)
-    cuts = [seam["cut"] for seam in distributed.attrs["seams"]]
-    present, kept, _ = agreement(single, distributed, cuts)
-    assert present >= 0.999
-    assert kept >= 0.98
+    agreed = sillage.dask.agreement(single, distributed)
+    assert agreed["points"] >= 0.999
+    assert agreed["identities"] >= 0.98
 
 
 def test_dask_writes_partitioned_parquet(sequence, client, tmp_path):

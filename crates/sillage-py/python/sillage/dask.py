@@ -28,7 +28,7 @@ import pandas as pd
 
 from . import _TRACKER_COLUMNS, _overrides, _path, _sillage
 
-__all__ = ["track", "DEFAULT_OVERLAP"]
+__all__ = ["track", "agreement", "DEFAULT_OVERLAP"]
 
 #: Frames shared by consecutive windows when ``overlap`` is not given (the command line's
 #: default; chosen on synthetic vortex flows, see ``docs/scale.md``).
@@ -101,6 +101,33 @@ def track(source: str | os.PathLike | np.ndarray, tracker: str = "ptv", *, windo
         if own_client is not None:
             own_client.close()
             own_client.cluster.close()
+
+
+def agreement(single: pd.DataFrame, stitched: pd.DataFrame,
+              cuts: list | None = None) -> dict:
+    """How far a windowed run ``stitched`` agrees with the single run ``single`` of the same
+    frames: the share of the single run's points present in ``stitched`` at the same frame
+    and position (``points``), and of its trajectories with points on both sides of a cut the
+    share whose points carry one identity in ``stitched`` (``identities``, of ``crossing``).
+    ``cuts`` default to the seams in ``stitched.attrs["seams"]``.
+
+    >>> sillage.dask.agreement(sillage.track(path), sillage.dask.track(path, window=500))
+    {'points': 0.9999, 'identities': 0.998, 'crossing': 2225}
+    """
+    if cuts is None:
+        cuts = [seam["cut"] for seam in stitched.attrs.get("seams", [])]
+    keys = ["frame", "x", "y"]
+    merged = single.merge(stitched[keys + ["particle"]], on=keys, how="left",
+                          suffixes=("", "_stitched"))
+    found = merged["particle_stitched"].notna()
+    spans = single.groupby("particle")["frame"].agg(["min", "max"])
+    crossing = spans[[any(lo < cut <= hi for cut in cuts)
+                      for lo, hi in zip(spans["min"], spans["max"])]].index
+    ids = merged[merged["particle"].isin(crossing) & found]
+    one_identity = ids.groupby("particle")["particle_stitched"].nunique() == 1
+    return {"points": float(found.mean()) if len(found) else 1.0,
+            "identities": float(one_identity.mean()) if len(one_identity) else 1.0,
+            "crossing": int(len(crossing))}
 
 
 def _submit(client: Any, source: Any, spec: tuple, measured: str, windows: list,
