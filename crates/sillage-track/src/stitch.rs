@@ -143,11 +143,6 @@ impl Stitcher {
         self.next_id
     }
 
-    /// The seams joined so far.
-    pub fn seams(&self) -> &[SeamReport] {
-        &self.seams
-    }
-
     /// Adds the next window (windows come in order, each overlapping the previous by at most
     /// half its length); returns the points now final, in frame order (within a frame, in the
     /// windows' own order).
