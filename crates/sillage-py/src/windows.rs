@@ -181,12 +181,12 @@ pub fn track_window_frames<'py>(
     let bytes = py
         .detach(|| {
             let frames = || {
-                frames_of(&views).map(move |frame| {
+                Ok(frames_of(&views).map(move |frame| {
                     frame.map(|mut frame| {
                         frame.index += first;
                         frame
                     })
-                })
+                }))
             };
             on_threads(threads, || {
                 track_array_window(&config, &window, &measured, frames)

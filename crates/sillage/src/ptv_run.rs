@@ -19,7 +19,7 @@ use crate::pipeline::{FrameInput, FrameReport, Pipeline, RunSummary};
 use crate::toml_config::{Settings, dotted_keys, load_unvalidated, set_key};
 use crate::tracking::Tracking;
 use crate::tractrac::apply_par;
-use crate::windows::{Measured, Window, WindowPlan, WindowedRun, WindowedSummary};
+use crate::windows::{Window, WindowPlan, WindowedRun, WindowedSummary};
 
 impl Settings for PipelineConfig {
     fn validate(&self) -> Result<()> {
@@ -127,21 +127,14 @@ impl PtvRun {
             on_bad_frame,
             ..FrameOptions::default()
         };
-        Self::open_frames(config, input, frames, &Measured::default())
+        Self::open_frames(config, input, frames)
     }
 
     /// [`PtvRun::open`] on the frames `frames` selects (a time window: its `start_at`,
     /// `stop_at`, `max_frames`; its bad-frame policy). The background model starts from the
-    /// selected frames. What a run decides on its first frames is taken from `measured`
-    /// (decided by a windowed run's planner on the sequence's first frames, see
-    /// [`Measured`]); an `"auto"` blob scale or polarity not given there is measured here on
-    /// the sequence's first frame, whatever the selection, so that every window detects alike.
-    pub fn open_frames(
-        config: &PipelineConfig,
-        input: &str,
-        frames: FrameOptions,
-        measured: &Measured,
-    ) -> Result<Self> {
+    /// selected frames; an `"auto"` blob scale or polarity is measured on the sequence's first
+    /// frame, whatever the selection.
+    pub fn open_frames(config: &PipelineConfig, input: &str, frames: FrameOptions) -> Result<Self> {
         let mut pipeline = Pipeline::from_config(config)?;
         let background_frames = if pipeline.background_init_frames() > 0 {
             Some(pipeline.prime_background(open_frames(input, &frames)?)?)
@@ -149,10 +142,7 @@ impl PtvRun {
             None
         };
         let frame_count = open_frames(input, &frames)?.len();
-        measured.adopt(&mut pipeline)?;
-        if let DetectorConfig::Blob(_) = config.detector
-            && pipeline.calibration().is_none()
-        {
+        if let DetectorConfig::Blob(_) = config.detector {
             let first_frame = FrameOptions {
                 on_bad_frame: frames.on_bad_frame,
                 ..FrameOptions::default()

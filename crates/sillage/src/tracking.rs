@@ -22,7 +22,6 @@ use crate::pedestrian::immpf::{ImmpfRun, Scene};
 use crate::pedestrian::siftpf::track_siftpf;
 use crate::pedestrian::{ImmpfSettings, PedestrianInput, SiftPfSettings};
 use crate::ptv_run::PtvRun;
-use crate::windows::Measured;
 use crate::{Pipeline, PipelineConfig};
 
 /// One of the four trackers with everything it needs besides its frames.
@@ -91,7 +90,7 @@ pub fn track_source(
 ) -> Result<u64> {
     match tracking {
         Tracking::Pipeline(config) => {
-            let run = PtvRun::open_frames(config, source, frames.clone(), &Measured::default())?;
+            let run = PtvRun::open_frames(config, source, frames.clone())?;
             let summary = run.run(sink, &mut |_| on_frame())?;
             Ok(summary.frames)
         }

@@ -39,7 +39,6 @@ use sillage_track::stitch::{StitchParams, WindowTracks};
 
 use crate::config::{PipelineConfig, TrackerConfig};
 use crate::pipeline::Pipeline;
-use crate::ptv_run::PtvRun;
 use crate::tracking::{Tracking, track_source};
 
 /// One window: its place in the plan and its frames `first..=last`.
@@ -268,23 +267,21 @@ pub fn track_window(
     window: &Window,
     measured: &Measured,
 ) -> Result<WindowTracks> {
-    let mut points: Vec<TrackPoint> = Vec::new();
-    match for_window(tracking, window.index) {
-        Tracking::Pipeline(config) => {
-            PtvRun::open_frames(&config, source, window.frame_options(), measured)?
-                .run(&mut points, &mut |_| {})?;
-        }
-        pedestrians => {
-            // The motion detector's background learns from a lead-in before the window;
-            // what the tracker reports there is dropped.
-            let frames = FrameOptions {
-                start_at: window.first.saturating_sub(lead_in(&pedestrians)),
-                ..window.frame_options()
-            };
-            track_source(source, &pedestrians, &frames, &mut points, &mut || {})?;
-            points.retain(|p| p.frame >= window.first);
-        }
+    if let Tracking::Pipeline(config) = tracking {
+        return track_window_frames(config, window, measured, || {
+            open_frames(source, &window.frame_options())
+        });
     }
+    // The pedestrian trackers' motion detector learns its background from a lead-in before
+    // the window; what the tracker reports there is dropped.
+    let pedestrians = for_window(tracking, window.index);
+    let frames = FrameOptions {
+        start_at: window.first.saturating_sub(lead_in(&pedestrians)),
+        ..window.frame_options()
+    };
+    let mut points: Vec<TrackPoint> = Vec::new();
+    track_source(source, &pedestrians, &frames, &mut points, &mut || {})?;
+    points.retain(|p| p.frame >= window.first);
     Ok(WindowTracks {
         first: window.first,
         last: window.last,
@@ -292,15 +289,15 @@ pub fn track_window(
     })
 }
 
-/// Tracks one window of frames held in memory with PTV or a bedload tracker (the frames of a
-/// numpy array on a Dask worker): `measured` as for [`track_window`]; `frames` yields the
-/// window's frames, indexed as in the sequence (called twice with background subtraction:
-/// once to start the model).
+/// Tracks one window with PTV or a bedload tracker, its frames opened by `frames` (a file
+/// source, or the frames of a numpy array on a Dask worker), indexed as in the sequence
+/// (opened twice with background subtraction: once to start the model); `measured` as for
+/// [`track_window`].
 pub fn track_window_frames<I>(
     config: &PipelineConfig,
     window: &Window,
     measured: &Measured,
-    frames: impl Fn() -> I,
+    frames: impl Fn() -> Result<I>,
 ) -> Result<WindowTracks>
 where
     I: Iterator<Item = Result<Frame>>,
@@ -309,11 +306,11 @@ where
     seed_for_window(&mut config, window.index);
     let mut pipeline = Pipeline::from_config(&config)?;
     if pipeline.background_init_frames() > 0 {
-        pipeline.prime_background(frames())?;
+        pipeline.prime_background(frames()?)?;
     }
     measured.adopt(&mut pipeline)?;
     let mut points = Vec::new();
-    pipeline.run(frames(), &mut points, &mut |_| {})?;
+    pipeline.run(frames()?, &mut points, &mut |_| {})?;
     Ok(WindowTracks {
         first: window.first,
         last: window.last,
