@@ -212,8 +212,10 @@ pub fn lead_in(tracking: &Tracking) -> u64 {
 /// How the stitcher joins `tracking`'s windows. PTV's windows see identical detections: tracks
 /// join within 1 px and a point is a duplicate within 0.01 px. The particle filters' estimates
 /// of one object differ between windows by their random draws, so both distances are one
-/// radius of agreement: 3 px for beads (a fifth of a bead's radius), 15 px for people (half a
-/// person's width at PETS 2009's scale). Set before measuring, not tuned.
+/// radius of agreement: 3 px for beads (a fifth of a bead's radius; set before measuring),
+/// 15 px for people (half a person's width at PETS 2009's scale; raised from a first 10 px
+/// after PETS windows joined few people, with no measurable change: `docs/scale.md`). Not
+/// tuned on any figure reported.
 pub fn stitch_params(tracking: &Tracking) -> StitchParams {
     let agree_px = match tracking {
         Tracking::Pipeline(config) => match config.tracker {
