@@ -7,7 +7,7 @@ use clap::Args;
 use serde::Serialize;
 use sillage::io::{SkippedFrame, TrackFormat};
 use sillage::ptv_run::{PtvRun, load_ptv_config};
-use sillage::windows::{WindowPlan, min_window};
+use sillage::windows::WindowPlan;
 use sillage::{PipelineConfig, RunSummary, Tracking};
 
 use crate::progress::FrameProgress;
@@ -147,20 +147,8 @@ pub fn run(args: &PtvArgs) -> Result<()> {
 
 /// `sillage ptv … --window W`: the windows tracked `--jobs` at once, stitched into `--out`.
 fn run_windowed(args: &PtvArgs, run: PtvRun, format: TrackFormat, window: usize) -> Result<()> {
-    let frames = run.frame_count().ok_or_else(|| {
-        anyhow::anyhow!(
-            "{}: the number of frames is unknown (a video without a frame count); windows \
-             need it: convert the video to an image sequence",
-            args.input
-        )
-    })?;
     let tracking = Tracking::Pipeline(Box::new(load_config(&args.config)?));
-    let plan = WindowPlan::new(
-        frames as u64,
-        window,
-        args.windows.overlap,
-        min_window(&tracking),
-    )?;
+    let plan = WindowPlan::for_source(&args.input, window, args.windows.overlap, &tracking)?;
     let jobs = args.windows.jobs();
     let mut progress = FrameProgress::new(Some(plan.windows().len()), "windows");
     let outcome = run.run_windowed(&args.out, format, plan, jobs, &mut |_| progress.tick());

@@ -10,7 +10,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use sillage::Tracking;
 use sillage::core::TrackPoint;
-use sillage::io::FrameOptions;
 use sillage::track::stitch::{Stitcher as WindowStitcher, WindowTracks};
 use sillage::windows::{
     Measured, Window, WindowPlan, WindowedRun, decode_window, encode_window, min_window,
@@ -38,13 +37,7 @@ fn tracking_of(
 /// a video does not record it.
 #[pyfunction]
 pub fn frame_count(source: String) -> PyResult<u64> {
-    let frames = sillage::io::open_frames(&source, &FrameOptions::default()).map_err(to_py)?;
-    frames.len().map(|n| n as u64).ok_or_else(|| {
-        PyValueError::new_err(format!(
-            "{source}: the number of frames is unknown (a video without a frame count); \
-             windows need it: convert the video to an image sequence"
-        ))
-    })
+    sillage::windows::frame_count(&source).map_err(to_py)
 }
 
 /// The windows `(index, first, last)` of `frames` frames cut into windows of `window` frames

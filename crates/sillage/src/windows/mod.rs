@@ -140,23 +140,15 @@ impl WindowPlan {
         })
     }
 
-    /// [`WindowPlan::new`] for the frames of `source` (a folder, glob, TIFF stack or video
-    /// whose frame count is known) and the least window of `tracking`.
+    /// [`WindowPlan::new`] for the frames of `source` ([`frame_count`]) and the least window
+    /// of `tracking`.
     pub fn for_source(
         source: &str,
         window: usize,
         overlap: usize,
         tracking: &Tracking,
     ) -> Result<Self> {
-        let frames = open_frames(source, &FrameOptions::default())?
-            .len()
-            .ok_or_else(|| {
-                Error::input(format!(
-                    "{source}: the number of frames is unknown (a video without a frame \
-                     count); windows need it: convert the video to an image sequence"
-                ))
-            })?;
-        Self::new(frames as u64, window, overlap, min_window(tracking))
+        Self::new(frame_count(source)?, window, overlap, min_window(tracking))
     }
 
     /// The windows, in order: they start every `window − overlap` frames; a last window
@@ -184,6 +176,18 @@ impl WindowPlan {
             first += step;
         }
     }
+}
+
+/// The number of frames of `source` (a folder, glob, TIFF stack or video), which windows
+/// need; an error naming the fix for a video that does not record it.
+pub fn frame_count(source: &str) -> Result<u64> {
+    let frames = open_frames(source, &FrameOptions::default())?.len();
+    frames.map(|n| n as u64).ok_or_else(|| {
+        Error::input(format!(
+            "{source}: the number of frames is unknown (a video without a frame count); \
+             windows need it: convert the video to an image sequence"
+        ))
+    })
 }
 
 /// Fewest frames a window of `tracking` may have: 3 for PTV (a point is the middle of three
