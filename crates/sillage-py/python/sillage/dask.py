@@ -179,7 +179,8 @@ def _stitch(distributed: Any, futures: list, spec: tuple, out: Any) -> pd.DataFr
             parts.append(batch)
         elif len(batch["frame"]):
             path = os.path.join(os.fspath(out), f"part-{len(paths):05d}.parquet")
-            _write_atomically(pd.DataFrame(batch)[columns], path)
+            part = pd.DataFrame(batch)[columns]
+            _write_atomically(path, lambda partial: part.to_parquet(partial, index=False))
             paths.append(path)
 
     if out is not None:
@@ -210,16 +211,16 @@ def _require_pyarrow() -> None:
         raise ImportError("writing Parquet needs pyarrow: pip install pyarrow") from error
 
 
-def _write_atomically(frame: pd.DataFrame, path: str) -> None:
-    """Writes ``frame`` as Parquet under a temporary name, then renames it: a part is whole
-    or absent."""
+def _write_atomically(path: str, write: Any) -> None:
+    """Calls ``write(partial)`` on a temporary name beside ``path``, then renames it: the file
+    is whole or absent."""
     partial = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.partial")
-    frame.to_parquet(partial, index=False)
+    write(partial)
     os.replace(partial, path)
 
 
 def _write_text(path: str, text: str) -> None:
-    partial = os.path.join(os.path.dirname(path), f".{os.path.basename(path)}.partial")
-    with open(partial, "w", encoding="utf-8") as file:
-        file.write(text)
-    os.replace(partial, path)
+    def write(partial: str) -> None:
+        with open(partial, "w", encoding="utf-8") as file:
+            file.write(text)
+    _write_atomically(path, write)
