@@ -1,6 +1,7 @@
 //! Time windows from Python (`sillage.dask`, `sillage.track(..., window=W)`): the plan, one
-//! window tracked on a worker (its tracks handed back as bytes), the stitcher that joins them
-//! in order, and the local runner of `sillage ptv --window`.
+//! window tracked on a worker (its tracks handed back as bytes), the pieces of a run stitched
+//! apart (each window's edges, each seam, each window's share, made where the windows are; the
+//! identities planned in one place) and the local runner of `sillage ptv --window`.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -9,10 +10,14 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use sillage::Tracking;
+use sillage::assoc::SparseLapSolver;
 use sillage::core::TrackPoint;
-use sillage::track::stitch::{Stitcher as WindowStitcher, WindowTracks};
+use sillage::track::stitch::{
+    PartPlanner as StitchPlanner, WindowTracks, join_seam as join_window_seam,
+};
 use sillage::windows::{
-    Measured, Window, WindowPlan, WindowedRun, decode_window, encode_window, min_window,
+    Measured, Window, WindowPlan, WindowedRun, decode_edges, decode_ids, decode_plan, decode_seam,
+    decode_window, encode_edges, encode_ids, encode_plan, encode_seam, encode_window, min_window,
     on_threads, stitch_params, track_window as track_one_window,
     track_window_frames as track_array_window,
 };
@@ -104,7 +109,8 @@ fn measured_of(measured: Option<String>) -> PyResult<Measured> {
 
 /// Tracks window `index` (frames `first..=last`) of the frames at `source` with its kernels
 /// on `threads` threads (`None`: all cores), adopting the decisions `measured` of
-/// [`measure_first_frames`]; returns its tracks as bytes for [`Stitcher::push`].
+/// [`measure_first_frames`]; returns its tracks as bytes for [`window_edges`] and
+/// [`window_share`].
 #[pyfunction]
 #[pyo3(signature = (source, tracker, overrides, seed, files, index, first, last,
     measured=None, threads=None))]
@@ -203,58 +209,139 @@ fn without_diagnostics(mut tracks: WindowTracks) -> WindowTracks {
     tracks
 }
 
-/// Joins the windows of one run, pushed in order, into one set of trajectories.
+/// The edges of a window's tracks (bytes of [`track_window`]) for its seams: the window
+/// before ends at `previous_last`, the one after starts at `next_first` (`None` where there
+/// is none). Runs where the window's tracks are; the edges are a small part of them.
+#[pyfunction]
+#[pyo3(signature = (tracks, previous_last=None, next_first=None))]
+pub fn window_edges<'py>(
+    py: Python<'py>,
+    tracks: &Bound<'py, PyBytes>,
+    previous_last: Option<u64>,
+    next_first: Option<u64>,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let window = decode_window(tracks.as_bytes()).map_err(to_py)?;
+    let bytes = py.detach(|| encode_edges(&sorted(window).edges(previous_last, next_first)));
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// `window` with its points in frame order, as the stitcher's parts expect them.
+fn sorted(mut window: WindowTracks) -> WindowTracks {
+    if !window.points.is_sorted_by_key(|p| p.frame) {
+        window.points.sort_by_key(|p| p.frame);
+    }
+    window
+}
+
+/// What [`PartPlanner::push`] needs of a window's edges: its first frame and track ids.
+#[pyfunction]
+pub fn window_ids<'py>(
+    py: Python<'py>,
+    edges: &Bound<'py, PyBytes>,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let edges = decode_edges(edges.as_bytes()).map_err(to_py)?;
+    Ok(PyBytes::new(py, &encode_ids(edges.first, &edges.ids)))
+}
+
+/// Joins the seam between two consecutive windows from their edges ([`window_edges`]), with
+/// `tracker`'s join distances; returns the seam as bytes for [`PartPlanner::push`].
+#[pyfunction]
+#[pyo3(signature = (earlier, later, tracker, overrides, seed, files))]
+pub fn join_seam<'py>(
+    py: Python<'py>,
+    earlier: &Bound<'py, PyBytes>,
+    later: &Bound<'py, PyBytes>,
+    tracker: &str,
+    overrides: Vec<String>,
+    seed: u64,
+    files: HashMap<String, PathBuf>,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let params = stitch_params(&tracking_of(tracker, &overrides, seed, files)?);
+    let earlier = decode_edges(earlier.as_bytes()).map_err(to_py)?;
+    let later = decode_edges(later.as_bytes()).map_err(to_py)?;
+    let bytes = py
+        .detach(|| {
+            params.validate()?;
+            join_window_seam(&params, &mut SparseLapSolver::new(), &earlier, &later)
+                .map(|seam| encode_seam(&seam))
+        })
+        .map_err(to_py)?;
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// Hands out the run's global identities from the windows' ids and seams, pushed in window
+/// order, and plans each window's share of the stitched run.
 #[pyclass]
-pub struct Stitcher {
-    inner: Option<WindowStitcher>,
+pub struct PartPlanner {
+    inner: Option<StitchPlanner>,
 }
 
 #[pymethods]
-impl Stitcher {
-    /// A stitcher for `tracker`'s windows (its join distances).
+impl PartPlanner {
+    /// A planner for a run's first window.
     #[new]
-    #[pyo3(signature = (tracker, overrides, seed, files))]
-    fn new(
-        tracker: &str,
-        overrides: Vec<String>,
-        seed: u64,
-        files: HashMap<String, PathBuf>,
-    ) -> PyResult<Self> {
-        let tracking = tracking_of(tracker, &overrides, seed, files)?;
-        let inner = WindowStitcher::new(stitch_params(&tracking)).map_err(to_py)?;
-        Ok(Self { inner: Some(inner) })
+    fn new() -> Self {
+        Self {
+            inner: Some(StitchPlanner::new()),
+        }
     }
 
-    /// Adds the next window's tracks (bytes of `track_window`); returns the columns of the
-    /// points now final.
+    /// Adds the next window: its ids ([`window_ids`]) and the seam with the window before
+    /// ([`join_seam`]; `None` for the first window). Returns the plan of the window before
+    /// (bytes for [`window_share`]), or `None` after the first window.
+    #[pyo3(signature = (ids, seam=None))]
     fn push<'py>(
         &mut self,
         py: Python<'py>,
-        tracks: &Bound<'py, PyBytes>,
-    ) -> PyResult<Bound<'py, PyDict>> {
-        let window = decode_window(tracks.as_bytes()).map_err(to_py)?;
-        let points = self.stitcher()?.push(window).map_err(to_py)?;
-        all_track_columns(py, &points)
+        ids: &Bound<'py, PyBytes>,
+        seam: Option<&Bound<'py, PyBytes>>,
+    ) -> PyResult<Option<Bound<'py, PyBytes>>> {
+        let (first, ids) = decode_ids(ids.as_bytes()).map_err(to_py)?;
+        let seam = seam
+            .map(|seam| decode_seam(seam.as_bytes()))
+            .transpose()
+            .map_err(to_py)?;
+        let plan = self.planner()?.push(first, &ids, seam).map_err(to_py)?;
+        Ok(plan.map(|plan| PyBytes::new(py, &encode_plan(&plan))))
     }
 
-    /// The last points' columns and the seams (JSON); the stitcher is then spent.
-    fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<(Bound<'py, PyDict>, String)> {
-        self.stitcher()?;
-        let (points, seams) = self
+    /// The last window's plan (`None` when no window was pushed) and the seams' reports
+    /// (JSON); the planner is then spent.
+    fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<(Option<Bound<'py, PyBytes>>, String)> {
+        self.planner()?;
+        let (plan, seams) = self
             .inner
             .take()
-            .map(WindowStitcher::finish)
+            .map(StitchPlanner::finish)
             .unwrap_or_default();
-        Ok((all_track_columns(py, &points)?, to_json(&seams)?))
+        Ok((
+            plan.map(|plan| PyBytes::new(py, &encode_plan(&plan))),
+            to_json(&seams)?,
+        ))
     }
 }
 
-impl Stitcher {
-    fn stitcher(&mut self) -> PyResult<&mut WindowStitcher> {
+impl PartPlanner {
+    fn planner(&mut self) -> PyResult<&mut StitchPlanner> {
         self.inner
             .as_mut()
-            .ok_or_else(|| PyValueError::new_err("this stitcher has finished; make a new one"))
+            .ok_or_else(|| PyValueError::new_err("this planner has finished; make a new one"))
     }
+}
+
+/// One window's share of the stitched run: its tracks (bytes of [`track_window`]) under the
+/// `plan` [`PartPlanner::push`] made for it, as the columns of `sillage.track`. Runs where
+/// the window's tracks are.
+#[pyfunction]
+pub fn window_share<'py>(
+    py: Python<'py>,
+    tracks: &Bound<'py, PyBytes>,
+    plan: &Bound<'py, PyBytes>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let window = decode_window(tracks.as_bytes()).map_err(to_py)?;
+    let plan = decode_plan(plan.as_bytes()).map_err(to_py)?;
+    let points = py.detach(|| plan.apply(&sorted(window))).map_err(to_py)?;
+    all_track_columns(py, &points)
 }
 
 fn to_json(value: &impl serde::Serialize) -> PyResult<String> {

@@ -3,9 +3,9 @@ trajectories.
 
 The sequence is cut into windows of ``window`` frames, consecutive ones sharing ``overlap``
 frames; each window is tracked on its own by a Dask worker (frames read by the worker from a
-path every worker sees, or sent from an array), and the windows' tracks are joined in order by
-the stitcher, which pairs the tracks of the overlap and renumbers identities globally (see
-``docs/scale.md``). The result depends on ``window``, ``overlap`` and ``seed``, never on the
+path every worker sees, or sent from an array), and the windows are stitched where they are:
+each seam pairs the tracks of the overlap on a worker, and only the windows' track ids and
+the seams come to the client, which renumbers identities globally (see ``docs/scale.md``). The result depends on ``window``, ``overlap`` and ``seed``, never on the
 number of workers; it agrees with the single run of :func:`sillage.track` except for what a
 window's first frames cannot know (their warm-up), measured in ``docs/scale.md``.
 
@@ -55,9 +55,15 @@ def track(source: str | os.PathLike | np.ndarray, tracker: str = "ptv", *, windo
     ``LocalCluster`` on this machine is started for the call. A window whose task raised is
     tried again up to ``retries`` times; a window whose worker died is rescheduled by Dask.
 
+    The windows are stitched where they are: each seam is joined on a worker from the two
+    windows' points in the overlap, and each window's share of the result (the frames
+    between its two cuts) is made on the worker that holds the window; only the windows'
+    track ids and the seams come to this process, to hand out the global identities.
+
     Returns the trajectories in the columns of :func:`sillage.track`, frame by frame; with
-    ``out`` (a folder), writes them instead as partitioned Parquet, ``part-00000.parquet``
-    onwards, one per window once its seam is stitched (needs pyarrow), and returns the paths.
+    ``out`` (a folder), the workers write them instead as partitioned Parquet,
+    ``part-00000.parquet`` onwards, one per window, the frames from its first cut to its
+    second (needs pyarrow on the workers), and the paths are returned.
     The stitcher's report per seam is in ``tracks.attrs["seams"]`` (or, with ``out``, in
     ``seams.json`` beside the parts).
     """
@@ -95,8 +101,9 @@ def track(source: str | os.PathLike | np.ndarray, tracker: str = "ptv", *, windo
         except ValueError:
             own_client = client = distributed.Client(distributed.LocalCluster(processes=True))
     try:
-        futures = _submit(client, source, spec, measured, windows, retries)
-        return _stitch(distributed, futures, spec, out)
+        token = os.urandom(4).hex()
+        tracks = _submit(client, source, spec, measured, windows, retries, token)
+        return _stitch(client, tracks, windows, spec, out, retries, token)
     finally:
         if own_client is not None:
             own_client.close()
@@ -131,9 +138,8 @@ def agreement(single: pd.DataFrame, stitched: pd.DataFrame,
 
 
 def _submit(client: Any, source: Any, spec: tuple, measured: str, windows: list,
-            retries: int) -> list:
+            retries: int, token: str) -> list:
     """One task per window; an array's windows are scattered to the workers first."""
-    token = os.urandom(4).hex()
     futures = []
     for index, first, last in windows:
         frames = source
@@ -164,44 +170,63 @@ def _worker_threads() -> int | None:
     return int(getattr(state, "nthreads", 0)) or None
 
 
-def _stitch(distributed: Any, futures: list, spec: tuple, out: Any) -> pd.DataFrame | list[str]:
-    """Joins the windows in order as they finish; one DataFrame, or the Parquet parts."""
-    tracker = spec[0]
-    columns = _TRACKER_COLUMNS[tracker]
-    stitcher = _sillage.Stitcher(*spec)
-    position = {future.key: k for k, future in enumerate(futures)}
-    ready: dict[int, bytes] = {}
-    parts: list[dict] = []
-    paths: list[str] = []
+def _stitch(client: Any, window_tracks: list, windows: list, spec: tuple, out: Any, retries: int,
+            token: str) -> pd.DataFrame | list[str]:
+    """Stitches the windows where they are: each window's edges, each seam and each window's
+    share of the result are tasks on the workers (a share written there as a Parquet part
+    with ``out``); only the windows' track ids and the seams come here, in window order, to
+    hand out the global identities."""
+    columns = _TRACKER_COLUMNS[spec[0]]
+    count = len(windows)
 
-    def emit(batch: dict) -> None:
-        if out is None:
-            parts.append(batch)
-        elif len(batch["frame"]):
-            path = os.path.join(os.fspath(out), f"part-{len(paths):05d}.parquet")
-            part = pd.DataFrame(batch)[columns]
-            _write_atomically(path, lambda partial: part.to_parquet(partial, index=False))
-            paths.append(path)
+    def task(name: str, k: int, function: Any, *arguments: Any) -> Any:
+        return client.submit(function, *arguments, key=f"sillage-{name}-{k}-{token}",
+                             retries=retries)
+
+    edges = [task("edges", k, _sillage.window_edges, window_tracks[k],
+                  windows[k - 1][2] if k > 0 else None,
+                  windows[k + 1][1] if k + 1 < count else None) for k in range(count)]
+    ids = [task("ids", k, _sillage.window_ids, edges[k]) for k in range(count)]
+    seams = [task("seam", k, _sillage.join_seam, edges[k - 1], edges[k], *spec)
+             for k in range(1, count)]
+    del edges  # each lives on as long as a seam needs it
+    planner = _sillage.PartPlanner()
+    shares = []
+
+    def share(k: int, plan: bytes) -> None:
+        path = None if out is None else os.path.join(os.fspath(out), f"part-{k:05d}.parquet")
+        shares.append(task("share", k, _window_share, window_tracks[k], plan, columns, path))
+        window_tracks[k] = None  # the window's tracks are freed once its share is made
 
     if out is not None:
         os.makedirs(out, exist_ok=True)
-    stitched = 0
-    for future in distributed.as_completed(futures):
-        ready[position[future.key]] = future.result()
-        future.release()
-        while stitched in ready:
-            emit(stitcher.push(ready.pop(stitched)))
-            stitched += 1
-    last, seams = stitcher.finish()
-    emit(last)
+    for k in range(count):
+        seam = seams[k - 1].result() if k > 0 else None
+        plan = planner.push(ids[k].result(), seam)
+        ids[k] = None
+        if plan is not None:
+            share(k - 1, plan)
+    plan, report = planner.finish()
+    if plan is not None:
+        share(count - 1, plan)
+    results = client.gather(shares)
     if out is not None:
-        _write_text(os.path.join(os.fspath(out), "seams.json"), seams)
-        return paths
-    # One copy of each column into the DataFrame, rather than one per window then a concat.
-    tracks = pd.DataFrame({name: np.concatenate([part[name] for part in parts])
-                           for name in columns})
-    tracks.attrs["seams"] = json.loads(seams)
+        _write_text(os.path.join(os.fspath(out), "seams.json"), report)
+        return results
+    tracks = pd.concat(results, ignore_index=True) if results else pd.DataFrame(columns=columns)
+    tracks.attrs["seams"] = json.loads(report)
     return tracks
+
+
+def _window_share(tracks: bytes, plan: bytes, columns: list[str],
+                  path: str | None) -> pd.DataFrame | str:
+    """Runs on a worker: the window's share of the stitched run, as a DataFrame, or written
+    to ``path`` as Parquet (whole or absent) and the path returned."""
+    part = pd.DataFrame(_sillage.window_share(tracks, plan))[columns]
+    if path is None:
+        return part
+    _write_atomically(path, lambda partial: part.to_parquet(partial, index=False))
+    return path
 
 
 def _require_pyarrow() -> None:

@@ -27,14 +27,19 @@
 mod agreement;
 mod measured;
 mod run;
+mod wire;
 
 pub use agreement::{WindowAgreement, agreement};
 pub use measured::{Measured, Voting};
 pub use run::{WindowedRun, WindowedSummary};
+pub use wire::{
+    decode_edges, decode_ids, decode_plan, decode_seam, decode_window, encode_edges, encode_ids,
+    encode_plan, encode_seam, encode_window,
+};
 
 use serde::Serialize;
 use sillage_core::{Error, FrameIndex, Result, TrackPoint};
-use sillage_io::{Frame, FrameOptions, decode_points, encode_points, open_frames};
+use sillage_io::{Frame, FrameOptions, open_frames};
 use sillage_track::stitch::{StitchParams, WindowTracks};
 
 use crate::config::{PipelineConfig, TrackerConfig};
@@ -340,33 +345,6 @@ pub fn on_threads<T: Send>(
     }
 }
 
-/// A window's tracks as bytes, to send from a worker to the stitcher: the window's first and
-/// last frames, then its points in the row spool's compact records (`encode_points`).
-pub fn encode_window(window: &WindowTracks) -> Vec<u8> {
-    let mut bytes = Vec::new();
-    bytes.extend_from_slice(&window.first.to_le_bytes());
-    bytes.extend_from_slice(&window.last.to_le_bytes());
-    encode_points(&window.points, &mut bytes);
-    bytes
-}
-
-/// The window's tracks [`encode_window`] encoded; an error for bytes of anything else.
-pub fn decode_window(bytes: &[u8]) -> Result<WindowTracks> {
-    let decoded = (|| {
-        let (first, rest) = bytes.split_first_chunk::<8>()?;
-        let (last, rest) = rest.split_first_chunk::<8>()?;
-        let (points, rest) = decode_points(rest)?;
-        rest.is_empty().then(|| WindowTracks {
-            first: u64::from_le_bytes(*first),
-            last: u64::from_le_bytes(*last),
-            points,
-        })
-    })();
-    decoded.ok_or_else(|| {
-        Error::input("these bytes are not a window's tracks; pass what track_window returned")
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -412,22 +390,6 @@ mod tests {
         assert!(err.contains("at least 4"), "{err}");
         let err = WindowPlan::new(2, 20, 4, 3).unwrap_err().to_string();
         assert!(err.contains("2 frames"), "{err}");
-    }
-
-    #[test]
-    fn window_tracks_survive_the_bytes_a_worker_sends() {
-        let tracks = WindowTracks {
-            first: 40,
-            last: 99,
-            points: vec![TrackPoint {
-                vel_px_per_frame: Some(sillage_core::Vec2::new(0.5, -1.0)),
-                ..TrackPoint::at(41, 3, sillage_core::Point2::new(1.25, 7.5))
-            }],
-        };
-        let bytes = encode_window(&tracks);
-        assert_eq!(decode_window(&bytes).unwrap(), tracks);
-        let err = decode_window(b"not tracks").unwrap_err().to_string();
-        assert!(err.contains("not a window's tracks"), "{err}");
     }
 
     #[test]

@@ -124,7 +124,7 @@ impl<'a> WindowedRun<'a> {
             result
         })?;
         let tracks = stitcher.tracks();
-        let (rest, seams) = stitcher.finish();
+        let (rest, seams) = stitcher.finish()?;
         points += rest.len() as u64;
         sink.accept(&rest)?;
         Ok(WindowedSummary {
