@@ -273,7 +273,6 @@ fn _sillage(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(windows::track_window, module)?)?;
     module.add_function(wrap_pyfunction!(windows::track_window_frames, module)?)?;
     module.add_function(wrap_pyfunction!(windows::track_windows, module)?)?;
-    module.add_function(wrap_pyfunction!(windows::window_edges, module)?)?;
     module.add_function(wrap_pyfunction!(windows::window_ids, module)?)?;
     module.add_function(wrap_pyfunction!(windows::join_seam, module)?)?;
     module.add_function(wrap_pyfunction!(windows::window_share, module)?)?;

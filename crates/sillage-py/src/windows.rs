@@ -107,13 +107,17 @@ fn measured_of(measured: Option<String>) -> PyResult<Measured> {
     })
 }
 
+/// A window's tracks and its edges, as bytes.
+type WindowBytes<'py> = (Bound<'py, PyBytes>, Bound<'py, PyBytes>);
+
 /// Tracks window `index` (frames `first..=last`) of the frames at `source` with its kernels
 /// on `threads` threads (`None`: all cores), adopting the decisions `measured` of
-/// [`measure_first_frames`]; returns its tracks as bytes for [`window_edges`] and
-/// [`window_share`].
+/// [`measure_first_frames`]; returns its tracks as bytes for [`window_share`], and its edges
+/// for [`join_seam`] and [`window_ids`] (the window before ends at `previous_last`, the one
+/// after starts at `next_first`; `None` where there is none).
 #[pyfunction]
 #[pyo3(signature = (source, tracker, overrides, seed, files, index, first, last,
-    measured=None, threads=None))]
+    measured=None, threads=None, previous_last=None, next_first=None))]
 #[allow(clippy::too_many_arguments)] // one argument each, as Python passes them
 pub fn track_window<'py>(
     py: Python<'py>,
@@ -127,7 +131,9 @@ pub fn track_window<'py>(
     last: u64,
     measured: Option<String>,
     threads: Option<usize>,
-) -> PyResult<Bound<'py, PyBytes>> {
+    previous_last: Option<u64>,
+    next_first: Option<u64>,
+) -> PyResult<WindowBytes<'py>> {
     let tracking = tracking_of(tracker, &overrides, seed, files)?;
     let measured = measured_of(measured)?;
     let window = Window { index, first, last };
@@ -136,17 +142,17 @@ pub fn track_window<'py>(
             on_threads(threads, || {
                 track_one_window(&source, &tracking, &window, &measured)
             })
-            .map(|tracks| encode_window(&without_diagnostics(tracks)))
+            .map(|tracks| encoded(tracks, previous_last, next_first))
         })
         .map_err(to_py)?;
-    Ok(PyBytes::new(py, &bytes))
+    Ok(window_bytes(py, bytes))
 }
 
 /// [`track_window`] on frames held in memory (PTV and bedload): `frames` are the window's
 /// frames `first..=last`.
 #[pyfunction]
 #[pyo3(signature = (frames, tracker, overrides, seed, files, index, first, last,
-    measured=None, threads=None))]
+    measured=None, threads=None, previous_last=None, next_first=None))]
 #[allow(clippy::too_many_arguments)] // one argument each, as Python passes them
 pub fn track_window_frames<'py>(
     py: Python<'py>,
@@ -160,7 +166,9 @@ pub fn track_window_frames<'py>(
     last: u64,
     measured: Option<String>,
     threads: Option<usize>,
-) -> PyResult<Bound<'py, PyBytes>> {
+    previous_last: Option<u64>,
+    next_first: Option<u64>,
+) -> PyResult<WindowBytes<'py>> {
     let measured = measured_of(measured)?;
     let Tracking::Pipeline(config) = tracking_of(tracker, &overrides, seed, files)? else {
         return Err(PyValueError::new_err(format!(
@@ -190,10 +198,10 @@ pub fn track_window_frames<'py>(
             on_threads(threads, || {
                 track_array_window(&config, &window, &measured, frames)
             })
-            .map(|tracks| encode_window(&without_diagnostics(tracks)))
+            .map(|tracks| encoded(tracks, previous_last, next_first))
         })
         .map_err(to_py)?;
-    Ok(PyBytes::new(py, &bytes))
+    Ok(window_bytes(py, bytes))
 }
 
 /// `tracks` without the fields no Python column carries (the motion model's predicted
@@ -209,20 +217,20 @@ fn without_diagnostics(mut tracks: WindowTracks) -> WindowTracks {
     tracks
 }
 
-/// The edges of a window's tracks (bytes of [`track_window`]) for its seams: the window
-/// before ends at `previous_last`, the one after starts at `next_first` (`None` where there
-/// is none). Runs where the window's tracks are; the edges are a small part of them.
-#[pyfunction]
-#[pyo3(signature = (tracks, previous_last=None, next_first=None))]
-pub fn window_edges<'py>(
-    py: Python<'py>,
-    tracks: &Bound<'py, PyBytes>,
+/// The window's tracks and edges encoded, without the fields no Python column carries.
+fn encoded(
+    tracks: WindowTracks,
     previous_last: Option<u64>,
     next_first: Option<u64>,
-) -> PyResult<Bound<'py, PyBytes>> {
-    let window = decode_window(tracks.as_bytes()).map_err(to_py)?;
-    let bytes = py.detach(|| encode_edges(&sorted(window).edges(previous_last, next_first)));
-    Ok(PyBytes::new(py, &bytes))
+) -> (Vec<u8>, Vec<u8>) {
+    let tracks = sorted(without_diagnostics(tracks));
+    let edges = tracks.edges(previous_last, next_first);
+    (encode_window(&tracks), encode_edges(&edges))
+}
+
+/// The bytes of [`encoded`] handed to Python.
+fn window_bytes(py: Python<'_>, (tracks, edges): (Vec<u8>, Vec<u8>)) -> WindowBytes<'_> {
+    (PyBytes::new(py, &tracks), PyBytes::new(py, &edges))
 }
 
 /// `window` with its points in frame order, as the stitcher's parts expect them.
@@ -233,7 +241,8 @@ fn sorted(mut window: WindowTracks) -> WindowTracks {
     window
 }
 
-/// What [`PartPlanner::push`] needs of a window's edges: its first frame and track ids.
+/// What [`PartPlanner::push`] needs of a window's edges (of [`track_window`]): its first
+/// frame and track ids.
 #[pyfunction]
 pub fn window_ids<'py>(
     py: Python<'py>,
@@ -243,7 +252,7 @@ pub fn window_ids<'py>(
     Ok(PyBytes::new(py, &encode_ids(edges.first, &edges.ids)))
 }
 
-/// Joins the seam between two consecutive windows from their edges ([`window_edges`]), with
+/// Joins the seam between two consecutive windows from their edges ([`track_window`]), with
 /// `tracker`'s join distances; returns the seam as bytes for [`PartPlanner::push`].
 #[pyfunction]
 #[pyo3(signature = (earlier, later, tracker, overrides, seed, files))]
@@ -338,9 +347,10 @@ pub fn window_share<'py>(
     tracks: &Bound<'py, PyBytes>,
     plan: &Bound<'py, PyBytes>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let window = decode_window(tracks.as_bytes()).map_err(to_py)?;
-    let plan = decode_plan(plan.as_bytes()).map_err(to_py)?;
-    let points = py.detach(|| plan.apply(&sorted(window))).map_err(to_py)?;
+    let (tracks, plan) = (tracks.as_bytes(), plan.as_bytes());
+    let points = py
+        .detach(|| decode_plan(plan)?.apply(sorted(decode_window(tracks)?)))
+        .map_err(to_py)?;
     all_track_columns(py, &points)
 }
 

@@ -104,12 +104,19 @@ def locate(frame: np.ndarray, *, params: Mapping[str, Any] | None = None,
     return batch(array, params=params, **detector)
 
 
+def _columns_frame(columns: dict, order: list[str]) -> pd.DataFrame:
+    """The DataFrame of the arrays ``columns`` (as the extension returns them) in ``order``,
+    taking the arrays as they are: building it by copy then selecting the columns copied
+    every value twice (1.6 s for 4 million PTV rows; this takes a millisecond)."""
+    return pd.DataFrame({name: columns[name] for name in order}, copy=False)
+
+
 def _frame_with_measured(columns: dict, order: list[str]) -> pd.DataFrame:
     """The DataFrame of ``columns`` in ``order``; what the run measured from the frames
     (``particle_sigma_px``, ``scale_px``, ``polarity``, and for PTV ``displacement_px`` and
     ``vote_search_px``) goes to its ``attrs``."""
     measured = columns.pop("measured", {})
-    frame = pd.DataFrame(columns)[order]
+    frame = _columns_frame(columns, order)
     frame.attrs.update(measured)
     return frame
 
@@ -186,8 +193,8 @@ def ptv_iter(frames: Iterable[np.ndarray] | str, *,
         stream = _sillage.PtvStream(overrides)
         steps = (stream.step(np.asarray(frame)) for frame in frames)
     for columns in steps:
-        yield pd.DataFrame(columns)[_TRACK_COLUMNS]
-    last = pd.DataFrame(stream.finish())[_TRACK_COLUMNS]
+        yield _columns_frame(columns, _TRACK_COLUMNS)
+    last = _columns_frame(stream.finish(), _TRACK_COLUMNS)
     if len(last):
         yield last
 
@@ -282,7 +289,7 @@ def track(source: str | Any, tracker: str = "ptv", *, seed: int = 1,
             columns, summary = _sillage.track_windows(_path(source), tracker, overrides,
                                                       int(seed), files, int(window),
                                                       int(overlap), jobs, update)
-        tracks = pd.DataFrame(columns)[_TRACKER_COLUMNS[tracker]]
+        tracks = _columns_frame(columns, _TRACKER_COLUMNS[tracker])
         tracks.attrs["seams"] = json.loads(summary)["seams"]
         return tracks
     with _progress(progress, max_frames, tracker) as update:
@@ -290,7 +297,7 @@ def track(source: str | Any, tracker: str = "ptv", *, seed: int = 1,
                                  _optional_path(sequence_params), _optional_path(mask),
                                  _optional_path(ground_plane), _optional_path(motion_prior),
                                  _optional_path(detections), max_frames, update)
-    return pd.DataFrame(columns)[_TRACKER_COLUMNS[tracker]]
+    return _columns_frame(columns, _TRACKER_COLUMNS[tracker])
 
 
 def detect(source: str | Any, detector: str = "blob", *,
@@ -321,7 +328,7 @@ def detect(source: str | Any, detector: str = "blob", *,
         columns = _sillage.detect(_path(source), detector, overrides,
                                   _optional_path(sequence_params), _optional_path(mask),
                                   max_frames, update)
-    return pd.DataFrame(columns)[_DETECTOR_COLUMNS[detector]]
+    return _columns_frame(columns, _DETECTOR_COLUMNS[detector])
 
 
 def _path(source: Any) -> str:
@@ -372,7 +379,7 @@ def track_bedload(detections: pd.DataFrame, *, candidates: pd.DataFrame | None =
     found = columns(detections, "detections")
     extra = None if candidates is None else columns(candidates, "candidates")
     result = _sillage.track_bedload(found, overrides, extra)
-    return pd.DataFrame(result)[_TRACK_COLUMNS + ["state", "class"]]
+    return _columns_frame(result, _TRACK_COLUMNS + ["state", "class"])
 
 
 def evaluate(truth: pd.DataFrame, tracks: pd.DataFrame, *, match: str | None = None,

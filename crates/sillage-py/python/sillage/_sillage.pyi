@@ -97,20 +97,19 @@ def measure_first_frames(
 def track_window(
     source: str, tracker: str, overrides: list[str], seed: int, files: Files, index: int,
     first: int, last: int, measured: Optional[str] = None, threads: Optional[int] = None,
-) -> bytes: ...
+    previous_last: Optional[int] = None, next_first: Optional[int] = None,
+) -> tuple[bytes, bytes]: ...
 def track_window_frames(
     frames: np.ndarray, tracker: str, overrides: list[str], seed: int, files: Files,
     index: int, first: int, last: int, measured: Optional[str] = None,
-    threads: Optional[int] = None,
-) -> bytes: ...
+    threads: Optional[int] = None, previous_last: Optional[int] = None,
+    next_first: Optional[int] = None,
+) -> tuple[bytes, bytes]: ...
 def track_windows(
     source: str, tracker: str, overrides: list[str], seed: int, files: Files, window: int,
     overlap: int, jobs: int, progress: Progress = None,
 ) -> tuple[Columns, str]: ...
 
-def window_edges(
-    tracks: bytes, previous_last: Optional[int] = None, next_first: Optional[int] = None,
-) -> bytes: ...
 def window_ids(edges: bytes) -> bytes: ...
 def join_seam(
     earlier: bytes, later: bytes, tracker: str, overrides: list[str], seed: int, files: Files,

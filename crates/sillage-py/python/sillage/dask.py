@@ -20,13 +20,14 @@ Dask dashboard (``client.dashboard_link``).
 from __future__ import annotations
 
 import json
+import operator
 import os
 from typing import Any, Mapping
 
 import numpy as np
 import pandas as pd
 
-from . import _TRACKER_COLUMNS, _overrides, _path, _sillage
+from . import _TRACKER_COLUMNS, _columns_frame, _overrides, _path, _sillage
 
 __all__ = ["track", "agreement", "DEFAULT_OVERLAP"]
 
@@ -102,8 +103,8 @@ def track(source: str | os.PathLike | np.ndarray, tracker: str = "ptv", *, windo
             own_client = client = distributed.Client(distributed.LocalCluster(processes=True))
     try:
         token = os.urandom(4).hex()
-        tracks = _submit(client, source, spec, measured, windows, retries, token)
-        return _stitch(client, tracks, windows, spec, out, retries, token)
+        tracks, edges = _submit(client, source, spec, measured, windows, retries, token)
+        return _stitch(client, tracks, edges, spec, out, retries, token)
     finally:
         if own_client is not None:
             own_client.close()
@@ -138,25 +139,34 @@ def agreement(single: pd.DataFrame, stitched: pd.DataFrame,
 
 
 def _submit(client: Any, source: Any, spec: tuple, measured: str, windows: list,
-            retries: int, token: str) -> list:
-    """One task per window; an array's windows are scattered to the workers first."""
-    futures = []
-    for index, first, last in windows:
+            retries: int, token: str) -> tuple[list, list]:
+    """One task per window (an array's windows are scattered to the workers first); returns
+    the futures of the windows' tracks and of their edges, both where the window was
+    tracked."""
+    tracks, edges = [], []
+    for k, (index, first, last) in enumerate(windows):
         frames = source
         if isinstance(source, np.ndarray):
             [frames] = client.scatter([np.ascontiguousarray(source[first:last + 1])])
-        futures.append(client.submit(_track_window, frames, spec, measured, index, first,
-                                     last, key=f"sillage-window-{index}-{token}",
-                                     retries=retries, pure=False))
-    return futures
+        neighbours = (windows[k - 1][2] if k > 0 else None,
+                      windows[k + 1][1] if k + 1 < len(windows) else None)
+        both = client.submit(_track_window, frames, spec, measured, index, first, last,
+                             neighbours, key=f"sillage-window-{index}-{token}",
+                             retries=retries, pure=False)
+        tracks.append(client.submit(operator.itemgetter(0), both,
+                                    key=f"sillage-tracks-{index}-{token}"))
+        edges.append(client.submit(operator.itemgetter(1), both,
+                                   key=f"sillage-edges-{index}-{token}"))
+    return tracks, edges
 
 
 def _track_window(frames: Any, spec: tuple, measured: str, index: int, first: int,
-                  last: int) -> bytes:
-    """Runs on a worker: the window's tracks, as bytes, its kernels on the worker's threads."""
+                  last: int, neighbours: tuple) -> tuple[bytes, bytes]:
+    """Runs on a worker: the window's tracks and its edges (for the seams with the windows
+    ending and starting at ``neighbours``), as bytes, its kernels on the worker's threads."""
     threads = _worker_threads()
     track = _sillage.track_window if isinstance(frames, str) else _sillage.track_window_frames
-    return track(frames, *spec, index, first, last, measured, threads)
+    return track(frames, *spec, index, first, last, measured, threads, *neighbours)
 
 
 def _worker_threads() -> int | None:
@@ -170,26 +180,23 @@ def _worker_threads() -> int | None:
     return int(getattr(state, "nthreads", 0)) or None
 
 
-def _stitch(client: Any, window_tracks: list, windows: list, spec: tuple, out: Any, retries: int,
-            token: str) -> pd.DataFrame | list[str]:
-    """Stitches the windows where they are: each window's edges, each seam and each window's
-    share of the result are tasks on the workers (a share written there as a Parquet part
-    with ``out``); only the windows' track ids and the seams come here, in window order, to
-    hand out the global identities."""
+def _stitch(client: Any, window_tracks: list, edges: list, spec: tuple, out: Any,
+            retries: int, token: str) -> pd.DataFrame | list[str]:
+    """Stitches the windows where they are: each seam (from the two windows' edges) and each
+    window's share of the result are tasks on the workers (a share written there as a
+    Parquet part with ``out``); only the windows' track ids and the seams come here, in
+    window order, to hand out the global identities."""
     columns = _TRACKER_COLUMNS[spec[0]]
-    count = len(windows)
+    count = len(window_tracks)
 
     def task(name: str, k: int, function: Any, *arguments: Any) -> Any:
         return client.submit(function, *arguments, key=f"sillage-{name}-{k}-{token}",
                              retries=retries)
 
-    edges = [task("edges", k, _sillage.window_edges, window_tracks[k],
-                  windows[k - 1][2] if k > 0 else None,
-                  windows[k + 1][1] if k + 1 < count else None) for k in range(count)]
     ids = [task("ids", k, _sillage.window_ids, edges[k]) for k in range(count)]
     seams = [task("seam", k, _sillage.join_seam, edges[k - 1], edges[k], *spec)
              for k in range(1, count)]
-    del edges  # each lives on as long as a seam needs it
+    edges.clear()  # each lives on as long as a seam needs it
     planner = _sillage.PartPlanner()
     shares = []
 
@@ -222,7 +229,7 @@ def _window_share(tracks: bytes, plan: bytes, columns: list[str],
                   path: str | None) -> pd.DataFrame | str:
     """Runs on a worker: the window's share of the stitched run, as a DataFrame, or written
     to ``path`` as Parquet (whole or absent) and the path returned."""
-    part = pd.DataFrame(_sillage.window_share(tracks, plan))[columns]
+    part = _columns_frame(_sillage.window_share(tracks, plan), columns)
     if path is None:
         return part
     _write_atomically(path, lambda partial: part.to_parquet(partial, index=False))

@@ -158,7 +158,7 @@ impl Stitcher {
             &later,
         )?;
         let plan = self.planner.push(window.first, &later.ids, Some(seam))?;
-        let finished = plan.expect("a window came before").apply(&earlier)?;
+        let finished = plan.expect("a window came before").apply(earlier)?;
         self.pending = Some(window);
         Ok(finished)
     }
@@ -166,7 +166,7 @@ impl Stitcher {
     /// Hands back the last window's remaining points (in frame order) and the seams.
     pub fn finish(self) -> Result<(Vec<TrackPoint>, Vec<SeamReport>)> {
         let (plan, seams) = self.planner.finish();
-        let points = match (plan, &self.pending) {
+        let points = match (plan, self.pending) {
             (Some(plan), Some(window)) => plan.apply(window)?,
             _ => Vec::new(),
         };
@@ -351,7 +351,7 @@ mod tests {
         plans
             .into_iter()
             .zip(windows)
-            .flat_map(|(plan, window)| plan.apply(window).unwrap())
+            .flat_map(|(plan, window)| plan.apply(window.clone()).unwrap())
             .collect()
     }
 

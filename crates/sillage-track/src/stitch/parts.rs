@@ -28,16 +28,15 @@ pub struct PartPlan {
 impl PartPlan {
     /// The window's share: its own points of frames `from..to` under their global ids, then
     /// `carried` and `head`, in frame order (within a frame, the window's own points first).
-    /// `window` must be the one planned for, its points in frame order.
-    pub fn apply(self, window: &WindowTracks) -> Result<Vec<TrackPoint>> {
-        let points = &window.points;
-        let start = points.partition_point(|p| p.frame < self.from);
+    /// `window` must be the one planned for, its points in frame order; its points are
+    /// reused, not copied.
+    pub fn apply(self, window: WindowTracks) -> Result<Vec<TrackPoint>> {
+        let mut share = window.points;
         let end = self
             .to
-            .map_or(points.len(), |to| points.partition_point(|p| p.frame < to));
-        let own = &points[start..end.max(start)];
-        let mut share = Vec::with_capacity(own.len() + self.carried.len() + self.head.len());
-        share.extend_from_slice(own);
+            .map_or(share.len(), |to| share.partition_point(|p| p.frame < to));
+        share.truncate(end);
+        share.drain(..share.partition_point(|p| p.frame < self.from));
         self.ids.renumber(&mut share)?;
         share.extend(self.carried);
         share.extend(self.head);
