@@ -120,3 +120,29 @@ def test_unknown_trackers_and_parameters_raise(sequence):
         sillage.dask.track(folder, "piv", window=WINDOW)
     with pytest.raises(ValueError, match="motion_av"):
         sillage.dask.track(folder, window=WINDOW, motion_av=0)
+
+
+def test_the_pieces_of_a_run_stitched_apart_refuse_each_others_bytes(sequence):
+    """The bytes that travel between workers and the client name what they are not."""
+    from sillage import _sillage
+    folder, _ = sequence
+    spec = ("ptv", [], 1, {})
+    tracks, edges = _sillage.track_window(folder, *spec, 0, 0, 39, None, 1, None, 24)
+    planner = _sillage.PartPlanner()
+    with pytest.raises(ValueError, match="not a window's track ids"):
+        planner.push(edges)
+    assert planner.push(_sillage.window_ids(edges)) is None
+    with pytest.raises(ValueError, match="pass the seam between them"):
+        planner.push(_sillage.window_ids(edges))
+    with pytest.raises(ValueError, match="not a seam"):
+        planner.push(_sillage.window_ids(edges), tracks)
+    with pytest.raises(ValueError, match="not a window's edges"):
+        _sillage.join_seam(tracks, edges, *spec)
+    plan, seams = planner.finish()
+    assert seams == "[]"
+    with pytest.raises(ValueError, match="not a window's tracks"):
+        _sillage.window_share(edges, plan)
+    share = _sillage.window_share(tracks, plan)
+    assert len(share["frame"]) > 0 and sorted(set(share["frame"])) == list(range(1, 39))
+    with pytest.raises(ValueError, match="has finished"):
+        planner.finish()

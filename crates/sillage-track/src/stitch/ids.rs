@@ -102,7 +102,7 @@ impl IdMap {
 /// Hands out global identities, window by window in order: a window's tracks that go on past
 /// its first cut get fresh ids in ascending order of their own, except those its seam with
 /// the window before joined, which take their partner's.
-#[derive(Debug, Default)]
+#[derive(Debug, Clone, Default)]
 pub(super) struct Numbering {
     next_id: TrackId,
 }

@@ -69,33 +69,63 @@ impl PartPlanner {
 
     /// Adds the next window: its first frame, its `ids` and the `seam` with the window before
     /// (`None` for the first window only). Returns the plan of the window before, now
-    /// complete.
+    /// complete. On an error nothing changes: the window can be pushed again, corrected.
     pub fn push(
         &mut self,
         first: FrameIndex,
         ids: &[TrackId],
         seam: Option<Seam>,
     ) -> Result<Option<PartPlan>> {
-        let (last, seam) = match (self.last.take(), seam) {
+        let mut numbering = self.numbering.clone();
+        match (self.last.take(), seam) {
             (None, None) => {
-                let map = self.numbering.window(ids, &[], None)?;
+                let map = numbering.window(ids, &[], None)?;
+                self.numbering = numbering;
                 self.last = Some((map, first, Vec::new()));
-                return Ok(None);
+                Ok(None)
             }
-            (Some(last), Some(seam)) => (last, seam),
-            (None, Some(_)) => {
-                return Err(Error::input(
-                    "the first window has no seam before it; pass None for it",
-                ));
+            (Some((previous, from, carried)), Some(seam)) => {
+                match Self::follow(&mut numbering, &previous, ids, seam) {
+                    Ok((map, report, earlier_tail, head)) => {
+                        self.numbering = numbering;
+                        self.last = Some((map, report.cut, earlier_tail));
+                        let to = Some(report.cut);
+                        self.seams.push(report);
+                        Ok(Some(PartPlan {
+                            from,
+                            to,
+                            ids: previous,
+                            carried,
+                            head,
+                        }))
+                    }
+                    Err(error) => {
+                        self.last = Some((previous, from, carried));
+                        Err(error)
+                    }
+                }
             }
-            (Some(_), None) => {
-                return Err(Error::input(format!(
+            (None, Some(_)) => Err(Error::input(
+                "the first window has no seam before it; pass None for it",
+            )),
+            (Some(last), None) => {
+                self.last = Some(last);
+                Err(Error::input(format!(
                     "the window from frame {first} follows another: pass the seam between them"
-                )));
+                )))
             }
-        };
-        let (previous, from, carried) = last;
-        let map = self.numbering.window(ids, &seam.joined, Some(&previous))?;
+        }
+    }
+
+    /// The ids of a window that follows the one mapped by `previous` across `seam`, the
+    /// seam's report, and the points each side keeps of the other's, in global ids.
+    fn follow(
+        numbering: &mut Numbering,
+        previous: &IdMap,
+        ids: &[TrackId],
+        seam: Seam,
+    ) -> Result<(IdMap, SeamReport, Vec<TrackPoint>, Vec<TrackPoint>)> {
+        let map = numbering.window(ids, &seam.joined, Some(previous))?;
         let Seam {
             report,
             mut earlier_tail,
@@ -104,15 +134,7 @@ impl PartPlanner {
         } = seam;
         map.renumber(&mut later_head)?;
         previous.renumber(&mut earlier_tail)?;
-        self.last = Some((map, report.cut, earlier_tail));
-        self.seams.push(report);
-        Ok(Some(PartPlan {
-            from,
-            to: Some(self.seams.last().expect("pushed above").cut),
-            ids: previous,
-            carried,
-            head: later_head,
-        }))
+        Ok((map, report, earlier_tail, later_head))
     }
 
     /// The last window's plan (`None` when no window was pushed) and every seam's report.
@@ -125,5 +147,58 @@ impl PartPlanner {
             head: Vec::new(),
         });
         (plan, self.seams)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use sillage_core::Point2;
+
+    use super::*;
+
+    fn seam(cut: FrameIndex, joined: Vec<(TrackId, TrackId)>, head: Vec<TrackPoint>) -> Seam {
+        Seam {
+            report: SeamReport {
+                cut,
+                ..SeamReport::default()
+            },
+            joined,
+            earlier_tail: Vec::new(),
+            later_head: head,
+        }
+    }
+
+    #[test]
+    fn a_wrong_push_is_refused_and_changes_nothing() {
+        let mut planner = PartPlanner::new();
+        let err = planner.push(0, &[4, 9], Some(seam(5, vec![], vec![])));
+        assert!(
+            err.unwrap_err()
+                .to_string()
+                .contains("first window has no seam")
+        );
+        assert_eq!(planner.push(0, &[4, 9], None).unwrap(), None);
+        let err = planner.push(10, &[0, 1], None).unwrap_err().to_string();
+        assert!(err.contains("pass the seam between them"), "{err}");
+        // A seam joining a track the window before never had, or keeping a point of a track
+        // the later window has no id for.
+        let err = planner.push(10, &[0, 1], Some(seam(15, vec![(0, 77)], vec![])));
+        assert!(err.unwrap_err().to_string().contains("track 77"));
+        let stray = TrackPoint::at(12, 5, Point2::new(1.0, 1.0));
+        let err = planner.push(10, &[0, 1], Some(seam(15, vec![], vec![stray])));
+        assert!(err.unwrap_err().to_string().contains("track 5 of frame 12"));
+        assert_eq!(planner.tracks(), 2, "failed pushes hand out no ids");
+        // The same window, pushed right: track 0 continues window 0's track 9 (global 1).
+        let plan = planner
+            .push(10, &[0, 1], Some(seam(15, vec![(0, 9)], vec![])))
+            .unwrap()
+            .unwrap();
+        assert_eq!((plan.from, plan.to), (0, Some(15)));
+        assert_eq!(plan.ids.pairs(), [(4, 0), (9, 1)]);
+        let (last, seams) = planner.finish();
+        let last = last.unwrap();
+        assert_eq!((last.from, last.to), (15, None));
+        assert_eq!(last.ids.pairs(), [(0, 1), (1, 2)]);
+        assert_eq!(seams.len(), 1);
     }
 }
