@@ -2,7 +2,7 @@
 and of 2 single-threaded workers, and by the single run, in one run of this script.
 
     python benches/python/bench_dask_windows.py FRAMES_FOLDER [--window 100] [--overlap 16]
-                                                [--parquet]
+                                                [--parquet] [--dask-defaults]
 
 FRAMES_FOLDER is a sequence on disk, e.g. 400 frames of the vortex on 2048 x 2048 px:
 ``sillage synth vortex --out /tmp/v2048 --frames 400 --particles 25000 --width 2048
@@ -10,7 +10,8 @@ FRAMES_FOLDER is a sequence on disk, e.g. 400 frames of the vortex on 2048 x 204
 windowed runs against the single run (all cores, one process), and how far the stitched
 trajectories agree with the single run's (points present, seam-crossing identities kept).
 With ``--parquet`` the windowed runs write partitioned Parquet on the workers (``out=``)
-instead of returning one DataFrame to this process.
+instead of returning one DataFrame to this process. The workers start with
+``sillage.dask.FAST_WORKERS`` unless ``--dask-defaults`` is given.
 """
 
 import argparse
@@ -21,6 +22,7 @@ import platform
 import tempfile
 import time
 
+import dask
 import pandas as pd
 from distributed import Client, LocalCluster
 
@@ -40,17 +42,21 @@ def main():
     parser.add_argument("--overlap", type=int, default=16)
     parser.add_argument("--parquet", action="store_true",
                         help="write partitioned Parquet on the workers")
+    parser.add_argument("--dask-defaults", action="store_true",
+                        help="start the workers with Dask's defaults, not FAST_WORKERS")
     args = parser.parse_args()
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"sillage {sillage.__version__}, {args.frames}, window {args.window}, "
-          f"overlap {args.overlap}, {'Parquet parts' if args.parquet else 'one DataFrame'}")
+          f"overlap {args.overlap}, {'Parquet parts' if args.parquet else 'one DataFrame'}, "
+          f"{'Dask defaults' if args.dask_defaults else 'FAST_WORKERS'}")
 
     single_s, single = timed(lambda: sillage.track(args.frames))
     print(f"single run (one process, all cores): {single_s:.2f} s, {len(single)} points")
     runs = {}
     for workers in (1, 2):
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                          dashboard_address=":0") as cluster, Client(cluster) as client:
+        with dask.config.set({} if args.dask_defaults else sillage.dask.FAST_WORKERS), \
+                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                             dashboard_address=":0") as cluster, Client(cluster) as client:
             client.wait_for_workers(workers)
             with tempfile.TemporaryDirectory() as out:
                 seconds, _ = timed(lambda: sillage.dask.track(

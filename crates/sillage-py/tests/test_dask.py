@@ -146,3 +146,16 @@ def test_the_pieces_of_a_run_stitched_apart_refuse_each_others_bytes(sequence):
     assert len(share["frame"]) > 0 and sorted(set(share["frame"])) == list(range(1, 39))
     with pytest.raises(ValueError, match="has finished"):
         planner.finish()
+
+
+def test_fast_workers_start_without_dasks_malloc_trim_threshold(monkeypatch):
+    """FAST_WORKERS reaches the workers' environment (Dask's default sets the variable). A
+    nanny also sets it in the process that starts it, so it is cleared here first."""
+    import dask
+    for config, expected in ((sillage.dask.FAST_WORKERS, None), ({}, "65536")):
+        monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
+        with dask.config.set(config), LocalCluster(n_workers=1, threads_per_worker=1,
+                                                   processes=True, dashboard_address=":0") \
+                as cluster, Client(cluster) as client:
+            found = client.submit(os.environ.get, "MALLOC_TRIM_THRESHOLD_").result()
+        assert found == expected
