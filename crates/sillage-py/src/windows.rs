@@ -223,7 +223,7 @@ fn encoded(
     previous_last: Option<u64>,
     next_first: Option<u64>,
 ) -> (Vec<u8>, Vec<u8>) {
-    let tracks = sorted(without_diagnostics(tracks));
+    let tracks = without_diagnostics(tracks).in_frame_order();
     let edges = tracks.edges(previous_last, next_first);
     (encode_window(&tracks), encode_edges(&edges))
 }
@@ -231,14 +231,6 @@ fn encoded(
 /// The bytes of [`encoded`] handed to Python.
 fn window_bytes(py: Python<'_>, (tracks, edges): (Vec<u8>, Vec<u8>)) -> WindowBytes<'_> {
     (PyBytes::new(py, &tracks), PyBytes::new(py, &edges))
-}
-
-/// `window` with its points in frame order, as the stitcher's parts expect them.
-fn sorted(mut window: WindowTracks) -> WindowTracks {
-    if !window.points.is_sorted_by_key(|p| p.frame) {
-        window.points.sort_by_key(|p| p.frame);
-    }
-    window
 }
 
 /// What [`PartPlanner::push`] needs of a window's edges (of [`track_window`]): its first
@@ -349,7 +341,7 @@ pub fn window_share<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (tracks, plan) = (tracks.as_bytes(), plan.as_bytes());
     let points = py
-        .detach(|| decode_plan(plan)?.apply(sorted(decode_window(tracks)?)))
+        .detach(|| decode_plan(plan)?.apply(decode_window(tracks)?.in_frame_order()))
         .map_err(to_py)?;
     all_track_columns(py, &points)
 }

@@ -85,6 +85,15 @@ pub struct WindowTracks {
     pub points: Vec<TrackPoint>,
 }
 
+impl WindowTracks {
+    /// The same window with its points in frame order (kept within a frame), as its edges
+    /// and its share are cut from: nothing moves when a tracker gave them so.
+    pub fn in_frame_order(mut self) -> Self {
+        sort_points(&mut self.points);
+        self
+    }
+}
+
 /// What happened at one seam.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SeamReport {
@@ -136,14 +145,14 @@ impl Stitcher {
     /// Adds the next window (windows come in order, each overlapping the previous by at most
     /// half its length); returns the points now final, in frame order (within a frame, in the
     /// windows' own order).
-    pub fn push(&mut self, mut window: WindowTracks) -> Result<Vec<TrackPoint>> {
+    pub fn push(&mut self, window: WindowTracks) -> Result<Vec<TrackPoint>> {
         if window.first > window.last {
             return Err(Error::input(format!(
                 "a window from frame {} to frame {} is empty",
                 window.first, window.last
             )));
         }
-        sort_points(&mut window.points);
+        let window = window.in_frame_order();
         let Some(earlier) = self.pending.take() else {
             let ids = window.edges(None, None).ids;
             self.planner.push(window.first, &ids, None)?;
@@ -374,9 +383,7 @@ mod tests {
                 if k == 1 {
                     tracks.push(track(3, 21, 47, 0.5, 80.0));
                 }
-                let mut window = window(first, last, tracks);
-                sort_points(&mut window.points);
-                window
+                window(first, last, tracks).in_frame_order()
             })
             .collect();
         for params in [
