@@ -160,12 +160,14 @@ impl Stitcher {
             return Ok(Vec::new());
         };
         let later = window.edges(Some(earlier.last), None);
-        let seam = join_seam(
-            &self.params,
-            &mut self.solver,
-            &earlier.edges(None, Some(window.first)),
-            &later,
-        )?;
+        // As the earlier window of this seam only its tail counts (its ids came with it).
+        let earlier_edges = WindowEdges {
+            first: earlier.first,
+            last: earlier.last,
+            tail: earlier.tail(window.first),
+            ..WindowEdges::default()
+        };
+        let seam = join_seam(&self.params, &mut self.solver, &earlier_edges, &later)?;
         let plan = self.planner.push(window.first, &later.ids, Some(seam))?;
         let finished = plan.expect("a window came before").apply(earlier)?;
         self.pending = Some(window);

@@ -50,17 +50,20 @@ impl WindowTracks {
             ),
             None => (&points[..0], &points[..]),
         };
-        let tail = match next_first {
-            Some(next_first) => &points[points.partition_point(|p| p.frame < next_first)..],
-            None => &points[points.len()..],
-        };
         WindowEdges {
             first: self.first,
             last: self.last,
             head: head.to_vec(),
-            tail: tail.to_vec(),
+            tail: next_first.map(|next| self.tail(next)).unwrap_or_default(),
             ids: distinct_ids(from_cut),
         }
+    }
+
+    /// Its points from frame `next_first` on (those shared with a window starting there), in
+    /// frame order: what the seam with that window needs of this one as the earlier.
+    pub(super) fn tail(&self, next_first: FrameIndex) -> Vec<TrackPoint> {
+        let points = &self.points;
+        points[points.partition_point(|p| p.frame < next_first)..].to_vec()
     }
 }
 
