@@ -102,3 +102,38 @@ fn bad_options_are_user_errors_naming_the_option() {
         assert!(message.contains(option), "{args:?}: {message}");
     }
 }
+
+#[test]
+fn a_seqinfo_that_disagrees_with_the_frames_is_named_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("walkers");
+    common::synth_walkers(&seq, "crossing", 12);
+    let img1 = seq.join("img1");
+    let ini = seq.join("seqinfo.ini");
+    let written = std::fs::read_to_string(&ini).unwrap();
+    let line_of = |key: &str| 1 + written.lines().position(|l| l.starts_with(key)).unwrap();
+    let out = dir.path().join("out.txt");
+    let track =
+        |tracker: &'static str| ["track", tracker, path_str(&img1), "--out", path_str(&out)];
+    // As generated, and as the first frames of a longer sequence (seqLength above the count).
+    run_ok(&track("immpf"));
+    std::fs::write(&ini, written.replace("seqLength=12", "seqLength=795")).unwrap();
+    run_ok(&track("siftpf"));
+    // More frames than seqLength, or another frame size: the file and the key's line.
+    std::fs::write(&ini, written.replace("seqLength=12", "seqLength=10")).unwrap();
+    for tracker in ["immpf", "siftpf"] {
+        let message = run_user_error(&track(tracker));
+        let at = format!("seqinfo.ini:{}:", line_of("seqLength"));
+        assert!(
+            message.contains(&at) && message.contains("holds 12 frames"),
+            "{message}"
+        );
+    }
+    std::fs::write(&ini, written.replace("imWidth=320", "imWidth=640")).unwrap();
+    let message = run_user_error(&track("immpf"));
+    let at = format!("seqinfo.ini:{}:", line_of("imWidth"));
+    assert!(
+        message.contains(&at) && message.contains("imWidth is 640"),
+        "{message}"
+    );
+}

@@ -91,8 +91,8 @@ pub use frames::{
 pub use matrix::read_matrix_csv;
 pub use mot::{
     MotFileRole, MotGroundTruthWriter, MotResultsWriter, MotRow, MotSequenceFile, SeqInfo,
-    parse_mot_rows, parse_seqinfo, read_mot_rows, read_mot_sequence, read_seqinfo,
-    write_mot_results, write_seqinfo,
+    check_seqinfo_frames, parse_mot_rows, parse_seqinfo, read_mot_rows, read_mot_sequence,
+    read_seqinfo, write_mot_results, write_seqinfo,
 };
 pub use mot_events::{MOT_EVENTS_HEADER, MotEventKind, MotEventRow, MotEventsCsvWriter};
 pub use numeric_table::{ColumnValues, NumericFormat, NumericTable, write_numeric_table};

@@ -382,6 +382,71 @@ pub fn parse_seqinfo(path: &Path, text: &str) -> Result<SeqInfo> {
     Ok(info)
 }
 
+/// Checks the frames found in a MOTChallenge sequence's image folder (`image_dir`, e.g.
+/// `img1`) against the `seqinfo.ini` at `path`: `frames` (the folder's count, `None` when
+/// only part of it was read) above `seqLength`, or a frame size other than
+/// `imWidth`×`imHeight`, is an error naming the file and the key's line. Fewer frames than
+/// `seqLength` are a sequence's first frames, not an error (the shared PETS 2009 folder holds
+/// 150 of its 795). A `seqinfo.ini` whose `imDir` names another folder is not checked.
+pub fn check_seqinfo_frames(
+    path: &Path,
+    image_dir: &str,
+    frames: Option<u64>,
+    (width, height): (usize, usize),
+) -> Result<()> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|_| Error::format(path, None, "not valid UTF-8 text; save the file as UTF-8"))?;
+    let info = parse_seqinfo(path, text)?;
+    if info
+        .image_dir
+        .as_deref()
+        .is_some_and(|dir| dir != image_dir)
+    {
+        return Ok(());
+    }
+    let error = |key: &str, message: String| Error::format(path, key_line(text, key), message);
+    if let (Some(stated), Some(found)) = (info.frame_count, frames)
+        && found > stated
+    {
+        return Err(error(
+            "seqlength",
+            format!(
+                "seqLength is {stated} but {image_dir} holds {found} frames; correct seqLength \
+                 or remove the extra frames"
+            ),
+        ));
+    }
+    for (key, name, stated, found) in [
+        ("imwidth", "imWidth", info.image_width, width),
+        ("imheight", "imHeight", info.image_height, height),
+    ] {
+        if let Some(stated) = stated
+            && stated as usize != found
+        {
+            return Err(error(
+                key,
+                format!(
+                    "{name} is {stated} px but the frames of {image_dir} are {found} px; \
+                     correct {name}"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The 1-based line of `text` that gives `key` (lower case), any case and spacing.
+fn key_line(text: &str, key: &str) -> Option<usize> {
+    text.lines()
+        .position(|line| {
+            line.split(['=', ':'])
+                .next()
+                .is_some_and(|k| k.trim().eq_ignore_ascii_case(key))
+        })
+        .map(|index| index + 1)
+}
+
 /// Writes MOTChallenge results (10 fields: `frame,id,bb_left,bb_top,bb_width,bb_height,
 /// conf,x,y,z`, frames 1-based, `-1` for what is absent) batch by batch into
 /// `.NAME.partial`, renamed on [`MotResultsWriter::finish`]. Class and visibility, columns of
@@ -537,6 +602,37 @@ mod tests {
         let ini = dir.path().join("seqinfo.ini");
         write_seqinfo(&ini, &info).unwrap();
         assert_eq!(read_seqinfo(&ini).unwrap(), info);
+    }
+
+    #[test]
+    fn frames_that_disagree_with_seqinfo_are_named_by_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let ini = dir.path().join("seqinfo.ini");
+        std::fs::write(
+            &ini,
+            "[Sequence]\nname=walkers\nimDir=img1\nseqLength=20\nimWidth=320\nimHeight=240\n",
+        )
+        .unwrap();
+        // A sequence's first frames, the whole sequence, or a part of it read: fine.
+        for frames in [Some(12), Some(20), None] {
+            check_seqinfo_frames(&ini, "img1", frames, (320, 240)).unwrap();
+        }
+        let err = check_seqinfo_frames(&ini, "img1", Some(21), (320, 240))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("seqinfo.ini:4:") && err.contains("seqLength is 20"),
+            "{err}"
+        );
+        let err = check_seqinfo_frames(&ini, "img1", Some(20), (320, 200))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("seqinfo.ini:6:") && err.contains("imHeight is 240"),
+            "{err}"
+        );
+        // Another folder's seqinfo.
+        check_seqinfo_frames(&ini, "img2", Some(99), (1, 1)).unwrap();
     }
 
     fn parse(text: &str) -> Result<Vec<MotRow>> {

@@ -72,6 +72,27 @@ pub fn frame_size_beside(file: &Path) -> Option<(usize, usize)> {
     Some((info.image_width? as usize, info.image_height? as usize))
 }
 
+/// The frames of `input` opened with `options`; a MOTChallenge image folder (`SEQ/img1`) is
+/// first checked against its sequence's `SEQ/seqinfo.ini` when there is one
+/// ([`sillage_io::check_seqinfo_frames`]: the frame count when the whole folder is read, the
+/// frame size always).
+pub(super) fn open_sequence_frames(input: &str, options: &FrameOptions) -> Result<FrameSource> {
+    let frames = open_frames(input, options)?;
+    let folder = Path::new(input);
+    let (Some(name), Some(sequence)) = (folder.file_name(), folder.parent()) else {
+        return Ok(frames);
+    };
+    let ini = sequence.join("seqinfo.ini");
+    if folder.is_dir() && ini.is_file() {
+        let whole =
+            options.max_frames.is_none() && options.start_at == 0 && options.stop_at.is_none();
+        let count = frames.len().filter(|_| whole).map(|n| n as u64);
+        let name = name.to_string_lossy();
+        sillage_io::check_seqinfo_frames(&ini, &name, count, frames.dimensions())?;
+    }
+    Ok(frames)
+}
+
 impl PedestrianInput {
     /// Colour frames of `input` (motion blobs as candidates unless `detections` is given),
     /// or, without `input`, the detections alone over frames of `frame_size_px`; `frames`
@@ -95,7 +116,7 @@ impl PedestrianInput {
                     colour: true,
                     ..options.clone()
                 };
-                let frames = open_frames(input, &options)?;
+                let frames = open_sequence_frames(input, &options)?;
                 let size = frames.dimensions();
                 let len = frames.len();
                 (Some(frames), size, len, 0)

@@ -6,8 +6,9 @@ use std::time::{Duration, Instant};
 
 use sillage_core::{Error, Result};
 use sillage_detect::motion::{MotionBlob, MotionDetector, MotionParams};
-use sillage_io::{FrameOptions, FrameSource, MotRow, open_frames};
+use sillage_io::{FrameOptions, FrameSource, MotRow};
 
+use super::input::open_sequence_frames;
 use super::within;
 
 /// What a run found.
@@ -35,7 +36,7 @@ impl MotionDetection {
             max_frames,
             ..FrameOptions::default()
         };
-        let frames = open_frames(input, &options)?;
+        let frames = open_sequence_frames(input, &options)?;
         let (width, height) = frames.dimensions();
         let detector = MotionDetector::new(params, width, height)?;
         Ok(Self {

@@ -5,9 +5,10 @@ use std::time::{Duration, Instant};
 
 use sillage_core::{Error, Homography, Result};
 use sillage_detect::motion::{MotionBlob, MotionDetector};
-use sillage_io::{FrameOptions, MotRow, open_frames};
+use sillage_io::{FrameOptions, MotRow};
 use sillage_track::siftpf::{DetectedObject, SiftPfEstimate, SiftPfFrame, SiftPfTracker};
 
+use super::input::open_sequence_frames;
 use super::settings::SiftPfSettings;
 use super::within;
 
@@ -69,7 +70,7 @@ pub fn track_siftpf(
         colour: true,
         ..frames.clone()
     };
-    let mut frames = open_frames(input, &options)?;
+    let mut frames = open_sequence_frames(input, &options)?;
     let (width, height) = frames.dimensions();
     let expected = frames.len();
     let mut motion = MotionDetector::new(&settings.motion_detector, width, height)?;
