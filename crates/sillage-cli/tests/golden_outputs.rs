@@ -42,20 +42,7 @@ fn assert_rows(path: &Path, expected: u64, what: &str) {
 fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
     let dir = tempfile::tempdir().unwrap();
     let frames = dir.path().join("vortex");
-    run_ok(&[
-        "synth",
-        "vortex",
-        "--out",
-        path_str(&frames),
-        "--frames",
-        "12",
-        "--particles",
-        "800",
-        "--width",
-        "512",
-        "--height",
-        "512",
-    ]);
+    common::synth_vortex(&frames, 12, 800, (512, 512), &[]);
     // Changed once on purpose: the blob scale and polarity are measured from the frames by
     // default (issue "PTV that needs no hand tuning"); they were fixed at 2 px, bright.
     let expected = [

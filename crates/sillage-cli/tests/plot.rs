@@ -14,22 +14,7 @@ const FRAMES: usize = 12;
 fn tracked_vortex(dir: &Path) -> (PathBuf, PathBuf) {
     let frames = dir.join("frames");
     let tracks = dir.join("tracks.csv");
-    run_ok(&[
-        "synth",
-        "vortex",
-        "--out",
-        path_str(&frames),
-        "--frames",
-        &FRAMES.to_string(),
-        "--particles",
-        "120",
-        "--width",
-        "96",
-        "--height",
-        "64",
-        "--delta",
-        "0.02",
-    ]);
+    common::synth_vortex(&frames, FRAMES as u64, 120, (96, 64), &["--delta", "0.02"]);
     run_ok(&["ptv", path_str(&frames), "--out", path_str(&tracks)]);
     (frames, tracks)
 }

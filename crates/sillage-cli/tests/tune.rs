@@ -18,22 +18,7 @@ use tune_server::TuneServer;
 /// Three 256×192 vortex frames with 40 particles in `dir/frames`.
 fn vortex_frames(dir: &Path) -> String {
     let frames = dir.join("frames");
-    run_ok(&[
-        "synth",
-        "vortex",
-        "--out",
-        path_str(&frames),
-        "--frames",
-        "3",
-        "--particles",
-        "40",
-        "--width",
-        "256",
-        "--height",
-        "192",
-        "--snr",
-        "4",
-    ]);
+    common::synth_vortex(&frames, 3, 40, (256, 192), &["--snr", "4"]);
     path_str(&frames).to_string()
 }
 

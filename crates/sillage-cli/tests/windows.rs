@@ -10,20 +10,7 @@ use common::{path_str, run_ok, run_user_error, sillage, stderr};
 fn windows_give_the_same_file_whatever_the_jobs() {
     let dir = tempfile::tempdir().unwrap();
     let frames = dir.path().join("vortex");
-    run_ok(&[
-        "synth",
-        "vortex",
-        "--out",
-        path_str(&frames),
-        "--frames",
-        "70",
-        "--particles",
-        "300",
-        "--width",
-        "256",
-        "--height",
-        "256",
-    ]);
+    common::synth_vortex(&frames, 70, 300, (256, 256), &[]);
     let run = |jobs: &str| {
         let out = dir.path().join(format!("tracks_{jobs}.csv"));
         let json = run_ok(&[
@@ -57,20 +44,7 @@ fn windows_give_the_same_file_whatever_the_jobs() {
 fn bad_windows_are_refused_with_the_fix() {
     let dir = tempfile::tempdir().unwrap();
     let frames = dir.path().join("vortex");
-    run_ok(&[
-        "synth",
-        "vortex",
-        "--out",
-        path_str(&frames),
-        "--frames",
-        "12",
-        "--particles",
-        "50",
-        "--width",
-        "64",
-        "--height",
-        "64",
-    ]);
+    common::synth_vortex(&frames, 12, 50, (64, 64), &[]);
     let out = dir.path().join("tracks.csv");
     let ptv = |extra: &[&str]| {
         let mut args = vec!["ptv", path_str(&frames), "--out", path_str(&out)];

@@ -37,6 +37,36 @@ pub fn run_user_error(args: &[&str]) -> String {
     stderr(&output)
 }
 
+/// Writes `frames` frames of the TracTrac vortex (`sillage synth vortex`) with `particles`
+/// particles on `width`×`height` px into `out`, with the generator's `extra` options.
+#[allow(dead_code)] // not every test file needs the vortex
+pub fn synth_vortex(
+    out: &Path,
+    frames: u64,
+    particles: u64,
+    (width, height): (u64, u64),
+    extra: &[&str],
+) {
+    let (frames, particles) = (frames.to_string(), particles.to_string());
+    let (width, height) = (width.to_string(), height.to_string());
+    let mut args = vec![
+        "synth",
+        "vortex",
+        "--out",
+        path_str(out),
+        "--frames",
+        &frames,
+        "--particles",
+        &particles,
+        "--width",
+        &width,
+        "--height",
+        &height,
+    ];
+    args.extend_from_slice(extra);
+    run_ok(&args);
+}
+
 /// Writes generated walkers of `scenario` (`sillage synth walkers`), `frames` long, into `seq`
 /// (img1/, gt/gt.txt, seqinfo.ini).
 #[allow(dead_code)] // not every test file needs walkers
