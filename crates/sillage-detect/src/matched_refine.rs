@@ -153,15 +153,20 @@ impl MatchedRefiner {
         self.cell_start[0] = 0;
         let r2 = r * r;
         let mut isolated = std::mem::take(&mut self.isolated);
-        isolated.clear();
-        isolated.extend(detections.iter().enumerate().map(|(i, d)| {
-            self.neighbours(d.pos_px, offset).all(|j| {
-                j == i || {
-                    let q = detections[j].pos_px;
-                    (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2) >= r2
-                }
+        let this = &*self;
+        detections
+            .par_iter()
+            .enumerate()
+            .with_min_len(PAR_MIN_LEN)
+            .map(|(i, d)| {
+                this.neighbours(d.pos_px, offset).all(|j| {
+                    j == i || {
+                        let q = detections[j].pos_px;
+                        (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2) >= r2
+                    }
+                })
             })
-        }));
+            .collect_into_vec(&mut isolated);
         self.isolated = isolated;
     }
 

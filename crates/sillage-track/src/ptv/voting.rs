@@ -224,52 +224,27 @@ fn vote_field(
     bin: f64,
 ) -> Option<Vec<Vec2>> {
     let (a_starts, a_order) = grid.bucket(a);
-    let (b_starts, b_order) = grid.bucket(b);
+    let search = SearchGrid::new(grid, b, radius);
     let half = (radius / bin).ceil() as usize;
     let side = 2 * half + 1;
-    let reach = (radius / grid.cell).ceil() as usize;
-    let radius_sq = radius * radius;
     // Cells are independent: voted in parallel, each with its own histogram, so the result
     // does not depend on the number of threads.
     let mut field: Vec<Option<Vec2>> = vec![None; grid.len()];
-    let scratch = || (vec![0u32; side * side], Vec::new());
     field.par_iter_mut().enumerate().for_each_init(
-        scratch,
-        |(histogram, peak_votes), (c, slot)| {
+        || CellVotes::new(side),
+        |votes, (c, slot)| {
             let members = &a_order[a_starts[c]..a_starts[c + 1]];
             if members.is_empty() {
                 return;
             }
-            // Every pair (point of the cell, point of b near its prior target) as a residual
-            // displacement within `radius`.
-            let for_each_pair = |visit: &mut dyn FnMut(Vec2)| {
-                for &i in members {
-                    let target = a[i] + prior[i];
-                    let (tx, ty) = grid.cell_of(target);
-                    for cy in ty.saturating_sub(reach)..=(ty + reach).min(grid.ny - 1) {
-                        for cx in tx.saturating_sub(reach)..=(tx + reach).min(grid.nx - 1) {
-                            let cb = cy * grid.nx + cx;
-                            for &k in &b_order[b_starts[cb]..b_starts[cb + 1]] {
-                                let d = b[k] - target;
-                                if d.x * d.x + d.y * d.y <= radius_sq {
-                                    visit(d);
-                                }
-                            }
-                        }
-                    }
-                }
-            };
-            histogram.fill(0);
-            let mut votes = 0u64;
-            for_each_pair(&mut |d| {
-                let ix = ((d.x / bin).round() as i64 + half as i64) as usize;
-                let iy = ((d.y / bin).round() as i64 + half as i64) as usize;
-                histogram[iy.min(side - 1) * side + ix.min(side - 1)] += 1;
-                votes += 1;
-            });
-            let (peak_count, peak) = peak_3x3(histogram, side);
+            votes.pairs.clear();
+            for &i in members {
+                search.pairs_near(a[i] + prior[i], &mut votes.pairs);
+            }
+            let (peak_count, peak) = votes.peak(bin, half);
             // Random pairs spread over the search disc: their expected count in 3×3 bins.
-            let expected = votes as f64 * 9.0 / (std::f64::consts::PI * (radius / bin).powi(2));
+            let expected =
+                votes.pairs.len() as f64 * 9.0 / (std::f64::consts::PI * (radius / bin).powi(2));
             let significant = (peak_count as f64) >= MIN_PEAK_VOTES
                 && (peak_count as f64) > expected + PEAK_SIGMAS * expected.sqrt();
             if !significant {
@@ -280,40 +255,135 @@ fn vote_field(
                 (peak.1 as f64 - half as f64) * bin,
             );
             // The median of the votes near the peak: robust to the random pairs among them.
-            peak_votes.clear();
-            for_each_pair(&mut |d| {
-                if (d - centre).max_abs() <= 1.5 * bin {
-                    peak_votes.push(d);
-                }
-            });
-            *slot = Some(median_vec(peak_votes));
+            votes.near_peak.clear();
+            let near = votes
+                .pairs
+                .iter()
+                .filter(|&&d| (d - centre).max_abs() <= 1.5 * bin);
+            votes.near_peak.extend(near);
+            *slot = Some(median_vec(&votes.near_peak));
         },
     );
     reject_outliers(&mut field, grid, bin);
     fill_gaps(field, grid)
 }
 
-/// The bin whose 3×3 neighbourhood holds the most votes (ties to the first in raster
-/// order) and that count.
-fn peak_3x3(histogram: &[u32], side: usize) -> (u32, (usize, usize)) {
-    let mut best = (0u32, (side / 2, side / 2));
-    for y in 0..side {
-        for x in 0..side {
-            if histogram[y * side + x] == 0 {
-                continue;
-            }
-            let mut sum = 0;
-            for yy in y.saturating_sub(1)..=(y + 1).min(side - 1) {
-                for xx in x.saturating_sub(1)..=(x + 1).min(side - 1) {
-                    sum += histogram[yy * side + xx];
+/// The points of frame `b` bucketed for the pair search: cells about half the search radius
+/// (at least half the points' spacing), so that a query tests few more points than the disc
+/// holds, whatever the size of the voting cells.
+struct SearchGrid<'a> {
+    grid: Grid,
+    starts: Vec<usize>,
+    order: Vec<usize>,
+    points: &'a [Point2],
+    reach: usize,
+    radius_sq: f64,
+}
+
+impl<'a> SearchGrid<'a> {
+    fn new(voting: &Grid, points: &'a [Point2], radius: f64) -> Self {
+        let (width, height) = (
+            voting.nx as f64 * voting.cell,
+            voting.ny as f64 * voting.cell,
+        );
+        let spacing = (width * height / points.len().max(1) as f64).sqrt();
+        let cell = (0.5 * radius).max(0.5 * spacing).max(1.0);
+        let count = |span: f64| ((span / cell).ceil() as usize).max(1);
+        let grid = Grid {
+            origin: voting.origin,
+            cell,
+            nx: count(width),
+            ny: count(height),
+        };
+        let (starts, order) = grid.bucket(points);
+        Self {
+            reach: (radius / cell).ceil() as usize,
+            radius_sq: radius * radius,
+            grid,
+            starts,
+            order,
+            points,
+        }
+    }
+
+    /// Appends `p − target` for every point `p` within the radius of `target`.
+    fn pairs_near(&self, target: Point2, out: &mut Vec<Vec2>) {
+        let grid = &self.grid;
+        let (tx, ty) = grid.cell_of(target);
+        for cy in ty.saturating_sub(self.reach)..=(ty + self.reach).min(grid.ny - 1) {
+            let row = cy * grid.nx;
+            let (x0, x1) = (
+                tx.saturating_sub(self.reach),
+                (tx + self.reach).min(grid.nx - 1),
+            );
+            // The cells of a row are contiguous in `order`.
+            for &k in &self.order[self.starts[row + x0]..self.starts[row + x1 + 1]] {
+                let d = self.points[k] - target;
+                if d.x * d.x + d.y * d.y <= self.radius_sq {
+                    out.push(d);
                 }
-            }
-            if sum > best.0 {
-                best = (sum, (x, y));
             }
         }
     }
-    best
+}
+
+/// One voting cell's scratch: its pairs' residuals and their histogram.
+struct CellVotes {
+    /// Residual displacements of the cell's pairs within the search radius.
+    pairs: Vec<Vec2>,
+    /// Vote counts per bin (`side × side`), all zero between cells.
+    histogram: Vec<u32>,
+    /// The bins that hold votes, each once.
+    voted: Vec<usize>,
+    /// The residuals near the peak.
+    near_peak: Vec<Vec2>,
+    side: usize,
+}
+
+impl CellVotes {
+    fn new(side: usize) -> Self {
+        Self {
+            pairs: Vec::new(),
+            histogram: vec![0; side * side],
+            voted: Vec::new(),
+            near_peak: Vec::new(),
+            side,
+        }
+    }
+
+    /// Bins the pairs (bins of `bin` px, `half` bins each side of zero) and returns the bin
+    /// whose 3×3 neighbourhood holds the most votes (ties to the first in raster order) with
+    /// that count; only the bins that hold votes are visited, and the histogram is left zero.
+    fn peak(&mut self, bin: f64, half: usize) -> (u32, (usize, usize)) {
+        let side = self.side;
+        self.voted.clear();
+        for d in &self.pairs {
+            let ix = ((d.x / bin).round() as i64 + half as i64) as usize;
+            let iy = ((d.y / bin).round() as i64 + half as i64) as usize;
+            let at = iy.min(side - 1) * side + ix.min(side - 1);
+            if self.histogram[at] == 0 {
+                self.voted.push(at);
+            }
+            self.histogram[at] += 1;
+        }
+        let mut best = (0u32, side / 2 * side + side / 2);
+        for &at in &self.voted {
+            let (x, y) = (at % side, at / side);
+            let mut sum = 0;
+            for yy in y.saturating_sub(1)..=(y + 1).min(side - 1) {
+                for xx in x.saturating_sub(1)..=(x + 1).min(side - 1) {
+                    sum += self.histogram[yy * side + xx];
+                }
+            }
+            if sum > best.0 || (sum == best.0 && at < best.1) {
+                best = (sum, at);
+            }
+        }
+        for &at in &self.voted {
+            self.histogram[at] = 0;
+        }
+        (best.0, (best.1 % side, best.1 / side))
+    }
 }
 
 /// The valid values among the 8 neighbours of cell (cx, cy).
@@ -457,6 +527,83 @@ mod tests {
             "{within_half_spacing} of {}",
             a.len()
         );
+    }
+
+    #[test]
+    fn the_pair_search_finds_exactly_the_points_within_the_radius() {
+        let b = random_points(2000, 300.0);
+        let extent = Extent::covering(b.iter());
+        let mut rng = sillage_core::rng_stream(4, 0);
+        for (cell, radius) in [(40.0, 19.4), (20.0, 2.3), (60.0, 45.0), (5.0, 30.0)] {
+            let search = SearchGrid::new(&Grid::new(&extent, cell), &b, radius);
+            // Targets inside and up to a radius outside the points' extent.
+            for _ in 0..300 {
+                let range = -radius..300.0 + radius;
+                let target = Point2::new(
+                    rng.random_range(range.clone()),
+                    rng.random_range(range.clone()),
+                );
+                let mut found = Vec::new();
+                search.pairs_near(target, &mut found);
+                let mut expected: Vec<Vec2> = b
+                    .iter()
+                    .map(|&p| p - target)
+                    .filter(|d| d.x * d.x + d.y * d.y <= radius * radius)
+                    .collect();
+                let key = |d: &Vec2| (d.x.to_bits(), d.y.to_bits());
+                found.sort_by_key(key);
+                expected.sort_by_key(key);
+                assert_eq!(
+                    found, expected,
+                    "cell {cell}, radius {radius}, at {target:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_peak_is_the_raster_scans_peak_and_the_histogram_is_left_zero() {
+        // The peak over the whole histogram in raster order, ties to the first.
+        fn raster_peak(histogram: &[u32], side: usize) -> (u32, (usize, usize)) {
+            let mut best = (0u32, (side / 2, side / 2));
+            for y in 0..side {
+                for x in 0..side {
+                    if histogram[y * side + x] == 0 {
+                        continue;
+                    }
+                    let mut sum = 0;
+                    for yy in y.saturating_sub(1)..=(y + 1).min(side - 1) {
+                        for xx in x.saturating_sub(1)..=(x + 1).min(side - 1) {
+                            sum += histogram[yy * side + xx];
+                        }
+                    }
+                    if sum > best.0 {
+                        best = (sum, (x, y));
+                    }
+                }
+            }
+            best
+        }
+        let (bin, half) = (1.0, 6);
+        let side = 2 * half + 1;
+        let mut votes = CellVotes::new(side);
+        let mut rng = sillage_core::rng_stream(5, 0);
+        for trial in 0..200 {
+            // Few votes on a coarse lattice: many ties.
+            votes.pairs.clear();
+            for _ in 0..(1 + trial % 12) {
+                let mut d = || f64::from(rng.random_range(-6i32..=6)) * 0.9;
+                votes.pairs.push(Vec2::new(d(), d()));
+            }
+            let mut histogram = vec![0u32; side * side];
+            for d in &votes.pairs {
+                let ix = ((d.x / bin).round() as i64 + half as i64) as usize;
+                let iy = ((d.y / bin).round() as i64 + half as i64) as usize;
+                histogram[iy * side + ix] += 1;
+            }
+            assert_eq!(votes.peak(bin, half), raster_peak(&histogram, side));
+            assert!(votes.histogram.iter().all(|&count| count == 0));
+        }
     }
 
     #[test]
