@@ -271,17 +271,18 @@ fn vote_field(
 /// The points of frame `b` bucketed for the pair search: cells about half the search radius
 /// (at least half the points' spacing), so that a query tests few more points than the disc
 /// holds, whatever the size of the voting cells.
-struct SearchGrid<'a> {
+struct SearchGrid {
     grid: Grid,
+    /// The points of cell `c` are `points[starts[c]..starts[c + 1]]`.
     starts: Vec<usize>,
-    order: Vec<usize>,
-    points: &'a [Point2],
+    /// The points in cell order, so that a query reads them contiguously.
+    points: Vec<Point2>,
     reach: usize,
     radius_sq: f64,
 }
 
-impl<'a> SearchGrid<'a> {
-    fn new(voting: &Grid, points: &'a [Point2], radius: f64) -> Self {
+impl SearchGrid {
+    fn new(voting: &Grid, points: &[Point2], radius: f64) -> Self {
         let (width, height) = (
             voting.nx as f64 * voting.cell,
             voting.ny as f64 * voting.cell,
@@ -301,8 +302,7 @@ impl<'a> SearchGrid<'a> {
             radius_sq: radius * radius,
             grid,
             starts,
-            order,
-            points,
+            points: order.iter().map(|&k| points[k]).collect(),
         }
     }
 
@@ -316,9 +316,9 @@ impl<'a> SearchGrid<'a> {
                 tx.saturating_sub(self.reach),
                 (tx + self.reach).min(grid.nx - 1),
             );
-            // The cells of a row are contiguous in `order`.
-            for &k in &self.order[self.starts[row + x0]..self.starts[row + x1 + 1]] {
-                let d = self.points[k] - target;
+            // The cells of a row are contiguous.
+            for &p in &self.points[self.starts[row + x0]..self.starts[row + x1 + 1]] {
+                let d = p - target;
                 if d.x * d.x + d.y * d.y <= self.radius_sq {
                     out.push(d);
                 }
@@ -331,9 +331,10 @@ impl<'a> SearchGrid<'a> {
 struct CellVotes {
     /// Residual displacements of the cell's pairs within the search radius.
     pairs: Vec<Vec2>,
-    /// Vote counts per bin (`side × side`), all zero between cells.
+    /// Vote counts per bin, `side × side` bins inside a border of empty bins (so that every
+    /// bin has 8 neighbours), all zero between cells.
     histogram: Vec<u32>,
-    /// The bins that hold votes, each once.
+    /// The bins that hold votes (indices into `histogram`), each once.
     voted: Vec<usize>,
     /// The residuals near the peak.
     near_peak: Vec<Vec2>,
@@ -344,7 +345,7 @@ impl CellVotes {
     fn new(side: usize) -> Self {
         Self {
             pairs: Vec::new(),
-            histogram: vec![0; side * side],
+            histogram: vec![0; (side + 2) * (side + 2)],
             voted: Vec::new(),
             near_peak: Vec::new(),
             side,
@@ -355,26 +356,23 @@ impl CellVotes {
     /// whose 3×3 neighbourhood holds the most votes (ties to the first in raster order) with
     /// that count; only the bins that hold votes are visited, and the histogram is left zero.
     fn peak(&mut self, bin: f64, half: usize) -> (u32, (usize, usize)) {
-        let side = self.side;
+        let (side, stride) = (self.side, self.side + 2);
         self.voted.clear();
         for d in &self.pairs {
             let ix = ((d.x / bin).round() as i64 + half as i64) as usize;
             let iy = ((d.y / bin).round() as i64 + half as i64) as usize;
-            let at = iy.min(side - 1) * side + ix.min(side - 1);
+            let at = (iy.min(side - 1) + 1) * stride + ix.min(side - 1) + 1;
             if self.histogram[at] == 0 {
                 self.voted.push(at);
             }
             self.histogram[at] += 1;
         }
-        let mut best = (0u32, side / 2 * side + side / 2);
+        let h = &self.histogram;
+        let mut best = (0u32, usize::MAX);
         for &at in &self.voted {
-            let (x, y) = (at % side, at / side);
-            let mut sum = 0;
-            for yy in y.saturating_sub(1)..=(y + 1).min(side - 1) {
-                for xx in x.saturating_sub(1)..=(x + 1).min(side - 1) {
-                    sum += self.histogram[yy * side + xx];
-                }
-            }
+            let row = |r: usize| h[r - 1] + h[r] + h[r + 1];
+            let sum = row(at - stride) + row(at) + row(at + stride);
+            // Padded indices keep the raster order.
             if sum > best.0 || (sum == best.0 && at < best.1) {
                 best = (sum, at);
             }
@@ -382,40 +380,67 @@ impl CellVotes {
         for &at in &self.voted {
             self.histogram[at] = 0;
         }
-        (best.0, (best.1 % side, best.1 / side))
+        if best.1 == usize::MAX {
+            return (0, (side / 2, side / 2));
+        }
+        (best.0, (best.1 % stride - 1, best.1 / stride - 1))
+    }
+}
+
+/// The valid values among the 8 neighbours of a cell, on the stack.
+struct Around {
+    values: [Vec2; 8],
+    len: usize,
+}
+
+impl Around {
+    fn as_slice(&self) -> &[Vec2] {
+        &self.values[..self.len]
     }
 }
 
 /// The valid values among the 8 neighbours of cell (cx, cy).
-fn neighbours(field: &[Option<Vec2>], grid: &Grid, cx: usize, cy: usize) -> Vec<Vec2> {
-    let mut out = Vec::with_capacity(8);
+fn neighbours(field: &[Option<Vec2>], grid: &Grid, cx: usize, cy: usize) -> Around {
+    let mut out = Around {
+        values: [Vec2::ZERO; 8],
+        len: 0,
+    };
     for y in cy.saturating_sub(1)..=(cy + 1).min(grid.ny - 1) {
         for x in cx.saturating_sub(1)..=(cx + 1).min(grid.nx - 1) {
             if (x, y) != (cx, cy)
                 && let Some(v) = field[y * grid.nx + x]
             {
-                out.push(v);
+                out.values[out.len] = v;
+                out.len += 1;
             }
         }
     }
     out
 }
 
-/// Component-wise median (of a non-empty set).
+/// Component-wise median (of a non-empty set); up to 8 values without allocating.
 fn median_vec(values: &[Vec2]) -> Vec2 {
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        let n = v.len();
+    let mut small = [0.0f64; 8];
+    let mut large = Vec::new();
+    let buffer: &mut [f64] = if values.len() <= small.len() {
+        &mut small[..values.len()]
+    } else {
+        large.resize(values.len(), 0.0);
+        &mut large
+    };
+    let mut median = |component: fn(&Vec2) -> f64| {
+        for (slot, v) in buffer.iter_mut().zip(values) {
+            *slot = component(v);
+        }
+        buffer.sort_unstable_by(f64::total_cmp);
+        let n = buffer.len();
         if n % 2 == 1 {
-            v[n / 2]
+            buffer[n / 2]
         } else {
-            0.5 * (v[n / 2 - 1] + v[n / 2])
+            0.5 * (buffer[n / 2 - 1] + buffer[n / 2])
         }
     };
-    Vec2::new(
-        median(values.iter().map(|v| v.x).collect()),
-        median(values.iter().map(|v| v.y).collect()),
-    )
+    Vec2::new(median(|v| v.x), median(|v| v.y))
 }
 
 /// Normalised median test on every valid cell with at least two valid neighbours: a cell
@@ -429,16 +454,15 @@ fn reject_outliers(field: &mut [Option<Vec2>], grid: &Grid, bin: f64) {
             let Some(v) = field[cy * grid.nx + cx] else {
                 continue;
             };
-            let around = neighbours(field, grid, cx, cy);
-            if around.len() < 2 {
+            let mut around = neighbours(field, grid, cx, cy);
+            if around.len < 2 {
                 continue;
             }
-            let median = median_vec(&around);
-            let spread: Vec<Vec2> = around
-                .iter()
-                .map(|&u| Vec2::new((u.x - median.x).abs(), (u.y - median.y).abs()))
-                .collect();
-            let scale = median_vec(&spread);
+            let median = median_vec(around.as_slice());
+            for u in &mut around.values[..around.len] {
+                *u = Vec2::new((u.x - median.x).abs(), (u.y - median.y).abs());
+            }
+            let scale = median_vec(around.as_slice());
             let rx = (v.x - median.x).abs() / (scale.x + floor);
             let ry = (v.y - median.y).abs() / (scale.y + floor);
             if rx.max(ry) > MEDIAN_TEST_THRESHOLD {
@@ -464,8 +488,8 @@ fn fill_gaps(mut field: Vec<Option<Vec2>>, grid: &Grid) -> Option<Vec<Vec2>> {
                 let c = cy * grid.nx + cx;
                 if field[c].is_none() {
                     let around = neighbours(&field, grid, cx, cy);
-                    if !around.is_empty() {
-                        filled[c] = Some(median_vec(&around));
+                    if around.len > 0 {
+                        filled[c] = Some(median_vec(around.as_slice()));
                     }
                 }
             }
