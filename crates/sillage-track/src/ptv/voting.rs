@@ -36,6 +36,8 @@ const MEDIAN_TEST_FLOOR_BINS: f64 = 0.1;
 /// many Poisson standard deviations, and holds at least [`MIN_PEAK_VOTES`].
 const PEAK_SIGMAS: f64 = 4.0;
 const MIN_PEAK_VOTES: f64 = 3.0;
+/// Fewest grid cells a rayon task tests or fills.
+const CELLS_PER_TASK: usize = 256;
 
 /// What a vote found besides the displacements.
 #[derive(Debug, Clone, Copy)]
@@ -448,30 +450,33 @@ fn median_vec(values: &[Vec2]) -> Vec2 {
 /// cells are tested against the field as it was before the test.
 fn reject_outliers(field: &mut [Option<Vec2>], grid: &Grid, bin: f64) {
     let floor = MEDIAN_TEST_FLOOR_BINS * bin;
-    let mut outliers = Vec::new();
-    for cy in 0..grid.ny {
-        for cx in 0..grid.nx {
-            let Some(v) = field[cy * grid.nx + cx] else {
-                continue;
-            };
-            let mut around = neighbours(field, grid, cx, cy);
-            if around.len < 2 {
-                continue;
-            }
-            let median = median_vec(around.as_slice());
-            for u in &mut around.values[..around.len] {
-                *u = Vec2::new((u.x - median.x).abs(), (u.y - median.y).abs());
-            }
-            let scale = median_vec(around.as_slice());
-            let rx = (v.x - median.x).abs() / (scale.x + floor);
-            let ry = (v.y - median.y).abs() / (scale.y + floor);
-            if rx.max(ry) > MEDIAN_TEST_THRESHOLD {
-                outliers.push(cy * grid.nx + cx);
-            }
+    let before: &[Option<Vec2>] = field;
+    let outlier = |c: usize| {
+        let Some(v) = before[c] else {
+            return false;
+        };
+        let mut around = neighbours(before, grid, c % grid.nx, c / grid.nx);
+        if around.len < 2 {
+            return false;
         }
-    }
-    for c in outliers {
-        field[c] = None;
+        let median = median_vec(around.as_slice());
+        for u in &mut around.values[..around.len] {
+            *u = Vec2::new((u.x - median.x).abs(), (u.y - median.y).abs());
+        }
+        let scale = median_vec(around.as_slice());
+        let rx = (v.x - median.x).abs() / (scale.x + floor);
+        let ry = (v.y - median.y).abs() / (scale.y + floor);
+        rx.max(ry) > MEDIAN_TEST_THRESHOLD
+    };
+    let outliers: Vec<bool> = (0..grid.len())
+        .into_par_iter()
+        .with_min_len(CELLS_PER_TASK)
+        .map(outlier)
+        .collect();
+    for (slot, outlier) in field.iter_mut().zip(outliers) {
+        if outlier {
+            *slot = None;
+        }
     }
 }
 
@@ -482,19 +487,17 @@ fn fill_gaps(mut field: Vec<Option<Vec2>>, grid: &Grid) -> Option<Vec<Vec2>> {
         return None;
     }
     while field.iter().any(Option::is_none) {
-        let mut filled = field.clone();
-        for cy in 0..grid.ny {
-            for cx in 0..grid.nx {
-                let c = cy * grid.nx + cx;
-                if field[c].is_none() {
-                    let around = neighbours(&field, grid, cx, cy);
-                    if around.len > 0 {
-                        filled[c] = Some(median_vec(around.as_slice()));
-                    }
-                }
-            }
-        }
-        field = filled;
+        let ring = &field;
+        field = (0..grid.len())
+            .into_par_iter()
+            .with_min_len(CELLS_PER_TASK)
+            .map(|c| {
+                ring[c].or_else(|| {
+                    let around = neighbours(ring, grid, c % grid.nx, c / grid.nx);
+                    (around.len > 0).then(|| median_vec(around.as_slice()))
+                })
+            })
+            .collect();
     }
     Some(field.into_iter().flatten().collect())
 }
