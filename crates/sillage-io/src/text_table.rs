@@ -122,23 +122,47 @@ pub(crate) fn push_fixed(out: &mut String, value: f64, decimals: usize) {
 
 /// Appends `n / 10^decimals` with exactly `decimals` digits after the point.
 fn push_scaled(out: &mut String, mut n: u64, decimals: usize) {
+    // "00" to "99": two digits per division.
+    const PAIRS: [u8; 200] = {
+        let mut table = [0u8; 200];
+        let mut i = 0;
+        while i < 100 {
+            table[2 * i] = b'0' + (i / 10) as u8;
+            table[2 * i + 1] = b'0' + (i % 10) as u8;
+            i += 1;
+        }
+        table
+    };
     let mut digits = [0u8; 32];
     let mut start = digits.len();
-    let mut written = 0;
-    loop {
-        if written == decimals && decimals > 0 {
-            start -= 1;
-            digits[start] = b'.';
-        }
+    // The decimals, right to left (two at a time while two remain).
+    let mut left = decimals;
+    while left >= 2 {
+        let pair = (n % 100) as usize * 2;
+        n /= 100;
+        start -= 2;
+        digits[start..start + 2].copy_from_slice(&PAIRS[pair..pair + 2]);
+        left -= 2;
+    }
+    if left == 1 {
         start -= 1;
         digits[start] = b'0' + (n % 10) as u8;
         n /= 10;
-        written += 1;
-        if n == 0 && written > decimals {
+    }
+    if decimals > 0 {
+        start -= 1;
+        digits[start] = b'.';
+    }
+    // The integer part, at least one digit.
+    loop {
+        start -= 1;
+        digits[start] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
             break;
         }
     }
-    out.extend(digits[start..].iter().map(|&b| b as char));
+    out.push_str(std::str::from_utf8(&digits[start..]).expect("ASCII digits"));
 }
 
 /// A CSV file with a header row, read with every column looked up by name.
