@@ -634,6 +634,36 @@ mod tests {
     }
 
     #[test]
+    fn the_vote_does_not_depend_on_the_number_of_threads() {
+        // A swirl with a noisy fifth of the points: peaks, outliers and gaps to fill.
+        let a = random_points(6000, 800.0);
+        let mut rng = sillage_core::rng_stream(7, 0);
+        let b: Vec<Point2> = a
+            .iter()
+            .map(|&p| {
+                let swirl = Vec2::new(-(p.y - 400.0), p.x - 400.0) * 0.02;
+                if rng.random_range(0.0..1.0) < 0.2 {
+                    Point2::new(rng.random_range(0.0..800.0), rng.random_range(0.0..800.0))
+                } else {
+                    p + swirl
+                }
+            })
+            .collect();
+        let vote_with = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut out = Vec::new();
+            pool.install(|| voted_displacements(&a, &b, None, 20.0, &mut out));
+            out
+        };
+        let one = vote_with(1);
+        assert_eq!(one.len(), a.len());
+        assert_eq!(one, vote_with(3));
+    }
+
+    #[test]
     fn no_motion_to_find_without_points() {
         let mut out = vec![Vec2::ZERO];
         assert!(voted_displacements(&[], &[Point2::new(1.0, 1.0)], None, 10.0, &mut out).is_none());
