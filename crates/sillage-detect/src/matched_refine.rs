@@ -22,6 +22,9 @@ pub const ISOLATION_SIGMAS: f64 = 4.0;
 /// (noise detections within 4σ hide faint spots), 2σ 100 %; the same on the tune half of
 /// the accuracy family.
 pub const MERGE_SIGMAS: f64 = 2.0;
+/// Farthest a 3-point sub-pixel fit moves a peak from its pixel (half a pixel per axis,
+/// `√0.5` px), with a margin for rounding.
+const FIT_SHIFT_BOUND_PX: f64 = 0.75;
 /// Fewest detections or peaks a rayon task handles.
 const PAR_MIN_LEN: usize = 512;
 /// Steps of the climb from a detection to the matched image's local maximum.
@@ -98,7 +101,10 @@ impl MatchedRefiner {
         };
         self.finder
             .find(&self.matched, 1, threshold, &mut self.peaks);
-        let merge2 = (MERGE_SIGMAS / ISOLATION_SIGMAS * self.isolation_px).powi(2);
+        let merge_px = MERGE_SIGMAS / ISOLATION_SIGMAS * self.isolation_px;
+        let merge2 = merge_px.powi(2);
+        // Half a pixel on each axis is 0.7071 px; the margin also covers rounding.
+        let merge_sure2 = (merge_px - FIT_SHIFT_BOUND_PX).max(0.0).powi(2);
         // The grid holds the detections as they were before any is added.
         let mut added = std::mem::take(&mut self.added);
         let this = &*self;
@@ -107,6 +113,13 @@ impl MatchedRefiner {
             .par_iter()
             .with_min_len(PAR_MIN_LEN)
             .map(|peak| {
+                // The fit moves a peak by at most half a pixel per axis: a detection well
+                // within the merge radius of the pixel is within it of the fit too, and
+                // most matched peaks are the particles already found.
+                let pixel = Point2::new(peak.x as f64 + offset.0, peak.y as f64 + offset.1);
+                if this.nearest_within(pixel, offset, found, merge_sure2) {
+                    return None;
+                }
                 let local = refine_peak(&this.matched, peak.x, peak.y, fit)?;
                 let p = Point2::new(local.x + offset.0, local.y + offset.1);
                 (!this.nearest_within(p, offset, found, merge2))
