@@ -8,6 +8,7 @@
 //! robust standard deviations of that scale's response); the polarity whose blobs stand out
 //! more (90th percentile of their significance) wins, and the measured σ is the median over its stronger half.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sillage_core::{Error, GrayImage, Result};
 use sillage_image::{LogFilter, Polarity, median_mad};
@@ -28,6 +29,10 @@ const MIN_BLOBS: usize = 1;
 const NOISE_FLOOR: f32 = 1e-3;
 /// Largest side of the central crop measured (bounds the cost on very large frames).
 const MAX_SIDE_PX: usize = 1024;
+/// Fewest pixels a rayon task scales or scans for the largest response.
+const PIXELS_PER_TASK: usize = 1 << 16;
+/// Fewest rows a rayon task scans for extrema.
+const ROWS_PER_TASK: usize = 32;
 
 /// What [`measure_particle_images`] found.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -74,13 +79,15 @@ pub fn measure_particle_images(image: &GrayImage) -> Result<ParticleImages> {
         let normalisation = (scale * scale) as f32;
         layers[slot]
             .as_mut_slice()
-            .iter_mut()
-            .for_each(|v| *v *= normalisation);
+            .par_chunks_mut(PIXELS_PER_TASK)
+            .for_each(|chunk| chunk.iter_mut().for_each(|v| *v *= normalisation));
+        // The largest magnitude is the same whatever the order of the comparisons.
         let floor = NOISE_FLOOR
             * layers[slot]
                 .as_slice()
-                .iter()
-                .fold(0.0f32, |m, v| m.max(v.abs()));
+                .par_chunks(PIXELS_PER_TASK)
+                .map(|chunk| chunk.iter().fold(0.0f32, |m, v| m.max(v.abs())))
+                .reduce(|| 0.0, f32::max);
         let white = pixel_noise * white_noise_gain(scale)?;
         noise[slot] = match median_mad(&layers[slot], &mut samples) {
             Some(s) => (s.median as f32, (s.sigma as f32).min(white).max(floor)),
@@ -235,43 +242,65 @@ fn collect_maxima(
         return;
     }
     let centre = &layers[ids[1]];
-    let (width, height) = centre.dimensions();
+    let height = centre.height();
     let threshold = SIGNIFICANCE as f32 * sigma;
-    for y in 1..height - 1 {
-        let row = centre.row(y);
-        for (x, &here) in row.iter().enumerate().take(width - 1).skip(1) {
-            let v = here - median;
-            if v.abs() <= threshold {
-                continue;
-            }
-            let sign = v.signum();
-            let value = sign * here;
-            let is_extremum = ids.iter().all(|&id| {
-                let layer = &layers[id];
-                (y - 1..=y + 1).all(|yy| {
-                    let r = layer.row(yy);
-                    (x - 1..=x + 1).all(|xx| {
-                        let other = sign * r[xx];
-                        other < value || (other == value && (id, yy, xx) == (ids[1], y, x))
-                    })
+    // Rows in parallel, their blobs gathered in row order: the same lists as one pass.
+    let rows: Vec<(Vec<Blob>, Vec<Blob>)> = (1..height - 1)
+        .into_par_iter()
+        .with_min_len(ROWS_PER_TASK)
+        .map(|y| row_extrema(layers, ids, (median, threshold, sigma), k, y))
+        .collect();
+    for (row_bright, row_dark) in rows {
+        bright.extend(row_bright);
+        dark.extend(row_dark);
+    }
+}
+
+/// [`collect_maxima`]'s extrema in row `y` of the centre layer (1 ≤ y < height − 1) whose
+/// distance from the median exceeds `threshold`: (bright, dark).
+fn row_extrema(
+    layers: &[GrayImage; 3],
+    ids: [usize; 3],
+    (median, threshold, sigma): (f32, f32, f32),
+    k: usize,
+    y: usize,
+) -> (Vec<Blob>, Vec<Blob>) {
+    let (mut bright, mut dark) = (Vec::new(), Vec::new());
+    let width = layers[ids[1]].width();
+    let row = layers[ids[1]].row(y);
+    for (x, &here) in row.iter().enumerate().take(width - 1).skip(1) {
+        let v = here - median;
+        if v.abs() <= threshold {
+            continue;
+        }
+        let sign = v.signum();
+        let value = sign * here;
+        let is_extremum = ids.iter().all(|&id| {
+            let layer = &layers[id];
+            (y - 1..=y + 1).all(|yy| {
+                let r = layer.row(yy);
+                (x - 1..=x + 1).all(|xx| {
+                    let other = sign * r[xx];
+                    other < value || (other == value && (id, yy, xx) == (ids[1], y, x))
                 })
-            });
-            if !is_extremum {
-                continue;
-            }
-            let at = |id: usize| f64::from(sign * layers[id].get(x, y));
-            let offset = sillage_image::parabola_offset(at(ids[0]), at(ids[1]), at(ids[2]));
-            let blob = Blob {
-                sigma_px: scale_of(k as f64 + offset),
-                significance: f64::from(v.abs() / sigma),
-            };
-            if sign > 0.0 {
-                bright.push(blob);
-            } else {
-                dark.push(blob);
-            }
+            })
+        });
+        if !is_extremum {
+            continue;
+        }
+        let at = |id: usize| f64::from(sign * layers[id].get(x, y));
+        let offset = sillage_image::parabola_offset(at(ids[0]), at(ids[1]), at(ids[2]));
+        let blob = Blob {
+            sigma_px: scale_of(k as f64 + offset),
+            significance: f64::from(v.abs() / sigma),
+        };
+        if sign > 0.0 {
+            bright.push(blob);
+        } else {
+            dark.push(blob);
         }
     }
+    (bright, dark)
 }
 
 #[cfg(test)]
@@ -306,6 +335,23 @@ mod tests {
                 assert!((m.sigma_px / sigma - 1.0).abs() < 0.15, "σ {sigma}: {m:?}");
             }
         }
+    }
+
+    #[test]
+    fn the_measurement_does_not_depend_on_the_number_of_threads() {
+        let mut image = spots(1.5, 0.5);
+        let noise = uniform_noise(160, 160, 7);
+        for (v, n) in image.as_mut_slice().iter_mut().zip(noise.as_slice()) {
+            *v += 0.05 * n;
+        }
+        let measure_with = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| measure_particle_images(&image).unwrap())
+        };
+        assert_eq!(measure_with(1), measure_with(3));
     }
 
     #[test]
