@@ -172,10 +172,10 @@ impl MatchedRefiner {
             .enumerate()
             .with_min_len(PAR_MIN_LEN)
             .map(|(i, d)| {
-                this.neighbours(d.pos_px, offset).all(|j| {
-                    j == i || {
+                !this.any_neighbour(d.pos_px, offset, |j| {
+                    j != i && {
                         let q = detections[j].pos_px;
-                        (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2) >= r2
+                        (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2) < r2
                     }
                 })
             })
@@ -191,19 +191,27 @@ impl MatchedRefiner {
         (cx.min(cols - 1), cy.min(rows - 1))
     }
 
-    /// The members of the cells around `p`'s, as built by [`MatchedRefiner::mark_isolated`].
-    fn neighbours(&self, p: Point2, offset: (f64, f64)) -> impl Iterator<Item = usize> + '_ {
+    /// Whether `test` holds for one of the members of the cells around `p`'s (the grid built
+    /// by [`MatchedRefiner::mark_isolated`]); stops at the first.
+    fn any_neighbour(
+        &self,
+        p: Point2,
+        offset: (f64, f64),
+        mut test: impl FnMut(usize) -> bool,
+    ) -> bool {
         let (cols, rows) = self.grid;
         let (cx, cy) = self.cell_of(p, offset);
-        (cy.saturating_sub(1)..=(cy + 1).min(rows - 1)).flat_map(move |y| {
-            (cx.saturating_sub(1)..=(cx + 1).min(cols - 1)).flat_map(move |x| {
-                let cell = y * cols + x;
-                self.cell_members
-                    [self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize]
-                    .iter()
-                    .map(|&j| j as usize)
-            })
-        })
+        for y in cy.saturating_sub(1)..=(cy + 1).min(rows - 1) {
+            // The three cells of a row are contiguous in `cell_members`.
+            let first = y * cols + cx.saturating_sub(1);
+            let last = y * cols + (cx + 1).min(cols - 1);
+            let members = &self.cell_members
+                [self.cell_start[first] as usize..self.cell_start[last + 1] as usize];
+            if members.iter().any(|&j| test(j as usize)) {
+                return true;
+            }
+        }
+        false
     }
 
     /// Whether one of `detections` (those the grid was built on) lies within `√r2` of `p`.
@@ -214,7 +222,7 @@ impl MatchedRefiner {
         detections: &[Detection],
         r2: f64,
     ) -> bool {
-        self.neighbours(p, offset).any(|j| {
+        self.any_neighbour(p, offset, |j| {
             let q = detections[j].pos_px;
             (q.x - p.x).powi(2) + (q.y - p.y).powi(2) < r2
         })
