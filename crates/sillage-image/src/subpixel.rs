@@ -77,9 +77,10 @@ pub fn refine_peak(image: &GrayImage, x: usize, y: usize, fit: SubpixelFit) -> O
             }
             let epsilon = LOG_EPSILON * height_above;
             let ln = |v: f64| (v - shift + epsilon).ln();
+            let ln_centre = ln(centre);
             (
-                parabola_offset(ln(left), ln(centre), ln(right)),
-                parabola_offset(ln(up), ln(centre), ln(down)),
+                parabola_offset(ln(left), ln_centre, ln(right)),
+                parabola_offset(ln(up), ln_centre, ln(down)),
             )
         }
     };
