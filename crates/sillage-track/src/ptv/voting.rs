@@ -263,7 +263,8 @@ fn vote_field(
                 .iter()
                 .filter(|&&d| (d - centre).max_abs() <= 1.5 * bin);
             votes.near_peak.extend(near);
-            *slot = Some(median_vec(&votes.near_peak));
+            votes.sorted.resize(votes.near_peak.len(), 0.0);
+            *slot = Some(median_vec(&votes.near_peak, &mut votes.sorted));
         },
     );
     reject_outliers(&mut field, grid, bin);
@@ -340,6 +341,8 @@ struct CellVotes {
     voted: Vec<usize>,
     /// The residuals near the peak.
     near_peak: Vec<Vec2>,
+    /// Their components, sorted for the median.
+    sorted: Vec<f64>,
     side: usize,
 }
 
@@ -350,6 +353,7 @@ impl CellVotes {
             histogram: vec![0; (side + 2) * (side + 2)],
             voted: Vec::new(),
             near_peak: Vec::new(),
+            sorted: Vec::new(),
             side,
         }
     }
@@ -399,6 +403,11 @@ impl Around {
     fn as_slice(&self) -> &[Vec2] {
         &self.values[..self.len]
     }
+
+    /// Their component-wise median (at least one value), sorted on the stack.
+    fn median(&self) -> Vec2 {
+        median_vec(self.as_slice(), &mut [0.0; 8][..self.len])
+    }
 }
 
 /// The valid values among the 8 neighbours of cell (cx, cy).
@@ -420,16 +429,9 @@ fn neighbours(field: &[Option<Vec2>], grid: &Grid, cx: usize, cy: usize) -> Arou
     out
 }
 
-/// Component-wise median (of a non-empty set); up to 8 values without allocating.
-fn median_vec(values: &[Vec2]) -> Vec2 {
-    let mut small = [0.0f64; 8];
-    let mut large = Vec::new();
-    let buffer: &mut [f64] = if values.len() <= small.len() {
-        &mut small[..values.len()]
-    } else {
-        large.resize(values.len(), 0.0);
-        &mut large
-    };
+/// Component-wise median of `values` (non-empty); each component is sorted in `buffer`, as
+/// long as `values`.
+fn median_vec(values: &[Vec2], buffer: &mut [f64]) -> Vec2 {
     let mut median = |component: fn(&Vec2) -> f64| {
         for (slot, v) in buffer.iter_mut().zip(values) {
             *slot = component(v);
@@ -459,11 +461,11 @@ fn reject_outliers(field: &mut [Option<Vec2>], grid: &Grid, bin: f64) {
         if around.len < 2 {
             return false;
         }
-        let median = median_vec(around.as_slice());
+        let median = around.median();
         for u in &mut around.values[..around.len] {
             *u = Vec2::new((u.x - median.x).abs(), (u.y - median.y).abs());
         }
-        let scale = median_vec(around.as_slice());
+        let scale = around.median();
         let rx = (v.x - median.x).abs() / (scale.x + floor);
         let ry = (v.y - median.y).abs() / (scale.y + floor);
         rx.max(ry) > MEDIAN_TEST_THRESHOLD
@@ -494,7 +496,7 @@ fn fill_gaps(mut field: Vec<Option<Vec2>>, grid: &Grid) -> Option<Vec<Vec2>> {
             .map(|c| {
                 ring[c].or_else(|| {
                     let around = neighbours(ring, grid, c % grid.nx, c / grid.nx);
-                    (around.len > 0).then(|| median_vec(around.as_slice()))
+                    (around.len > 0).then(|| around.median())
                 })
             })
             .collect();
