@@ -13,7 +13,7 @@
 //! from a Gaussian of the whole previous distribution.
 
 use serde::{Deserialize, Serialize};
-use sillage_core::{Error, Point2, Result, RngStream, TrackId, rng_stream};
+use sillage_core::{Error, Point2, Result, RngStream, TrackId, Vec2, rng_stream};
 
 use crate::linalg::{Gaussian, Matrix};
 use crate::motion::kinematic::KinematicModel;
@@ -250,6 +250,26 @@ impl ImmParticleFilter {
     /// (the proposal's importance ratio is not applied, as in Okuma et al.). A share ≤ 0
     /// moves nothing.
     pub fn propose_near(&mut self, share: f64, centre: Point2, sd_px: f64) {
+        self.propose(share, centre, sd_px, None);
+    }
+
+    /// [`Self::propose_near`] that also draws the moved particles' velocities from
+    /// `N(velocity, vel_sd² I)` (px/frame): where an observation gives the motion too (two
+    /// detections of one person), a filter whose particles have not learnt the person's
+    /// speed yet gets hypotheses that move with it.
+    pub fn propose_moving_near(
+        &mut self,
+        share: f64,
+        centre: Point2,
+        sd_px: f64,
+        velocity: Vec2,
+        vel_sd: f64,
+    ) {
+        self.propose(share, centre, sd_px, Some((velocity, vel_sd)));
+    }
+
+    /// The proposal of [`Self::propose_near`], velocities drawn too with `velocity`.
+    fn propose(&mut self, share: f64, centre: Point2, sd_px: f64, velocity: Option<(Vec2, f64)>) {
         if share.is_nan() || share <= 0.0 {
             return;
         }
@@ -262,6 +282,11 @@ impl ImmParticleFilter {
                 let (dx, dy) = normals.pair();
                 columns.pos_x[i] = centre.x + sd_px * dx;
                 columns.pos_y[i] = centre.y + sd_px * dy;
+                if let Some((v, sd)) = velocity {
+                    let (dx, dy) = normals.pair();
+                    columns.vel_x[i] = v.x + sd * dx;
+                    columns.vel_y[i] = v.y + sd * dy;
+                }
             }
         }
     }

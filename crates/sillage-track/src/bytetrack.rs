@@ -216,7 +216,7 @@ pub struct ByteTracker {
 /// Pairs `(row, column)` of the assignment of least cost over `costs` (rows × cols) in which
 /// every cost above `threshold` counts as `threshold + 1e-4`, kept where the true cost is at
 /// most `threshold` (`supervision`'s `linear_assignment`).
-fn assign(
+pub(crate) fn assign(
     solver: &mut LapSolver,
     rows: usize,
     cols: usize,

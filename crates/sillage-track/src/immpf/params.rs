@@ -74,14 +74,44 @@ impl ModelName {
     }
 }
 
-/// How a tracker is scored against detections when there are no images (the detections-only
-/// mode) — and how detections are matched to trackers.
+/// The detections-only mode (no frames): how detections are assigned to trackers, how they
+/// weigh the particles, and the trackers' life cycle there (the image mode's
+/// `confirm_frames`, `unsupported_frames`, revival and death rules do not apply).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DetectionLikelihoodParams {
-    /// A detection is matched to the tracker whose predicted box it overlaps most, when the
-    /// IoU reaches this; default 0.3.
+    /// Least IoU of a detection of score ≥ `high_score` with a tracker's predicted box for
+    /// the Hungarian assignment to pair them; default 0.3 (SORT's).
     pub match_iou: f64,
+    /// Detections of at least this score are assigned first, to every tracker, and start
+    /// trackers; the others are assigned second, to the trackers a detection held in the
+    /// previous frame, and start none (ByteTrack's two stages); default 0.5.
+    pub high_score: f64,
+    /// Least IoU of the second stage's pairs; default 0.5 (ByteTrack's).
+    pub low_match_iou: f64,
+    /// Matches in a row before a tracker is confirmed and reported (its earlier frames then
+    /// reported at once); a tracker that misses a detection before that ends; default 3
+    /// (SORT's `min_hits`).
+    pub min_hits: u32,
+    /// Frames a confirmed tracker is kept without a detection, unreported, its particles
+    /// coasting on their models, before it ends; a detection on its predicted box in that
+    /// time takes it back, identity and all; default 30 (ByteTrack's buffer).
+    pub lost_frames: u32,
+    /// Share of a matched tracker's particles drawn around its detection's foot point (σ
+    /// as the likelihood's) before weighting, so that a detection the prediction missed by
+    /// more than a few σ still has particles on it; default 0.5. 0: the paper's filter, whose
+    /// particles follow their motion models only.
+    pub proposal_share: f64,
+    /// At the first match of a streak (a tracker's second detection, or its first after a
+    /// miss), the proposed particles also take the velocity between the tracker's last two
+    /// detections; default true.
+    pub velocity_proposal: bool,
+    /// A tracker that missed a detection is reported again only after `min_hits` new matches
+    /// in a row (SORT); default true.
+    pub reconfirm_after_loss: bool,
+    /// When a tracker is (re)confirmed, report the frames of its streak before that too;
+    /// default false (SORT drops them).
+    pub report_first_hits: bool,
     /// σ of the Gaussian of the foot-point distance, as a fraction of the detection's
     /// height; default 0.1.
     pub foot_sigma_fraction: f64,
@@ -93,8 +123,8 @@ pub struct DetectionLikelihoodParams {
     /// Weight of a matched detection's size in the tracker's box size (exponential
     /// smoothing); default 0.3.
     pub size_smoothing: f64,
-    /// Report a tracker on the frames where no detection matched it (its prediction);
-    /// default false: reported only when a detection confirms it, as SORT does.
+    /// Report a confirmed tracker on the frames where no detection matched it (its
+    /// prediction); default false: reported only when a detection holds it, as SORT does.
     pub report_coasting: bool,
 }
 
@@ -102,6 +132,14 @@ impl Default for DetectionLikelihoodParams {
     fn default() -> Self {
         Self {
             match_iou: 0.3,
+            high_score: 0.5,
+            low_match_iou: 0.5,
+            min_hits: 3,
+            lost_frames: 30,
+            proposal_share: 0.5,
+            velocity_proposal: true,
+            reconfirm_after_loss: true,
+            report_first_hits: false,
             foot_sigma_fraction: 0.1,
             missed_log_likelihood: 0.01f64.ln(),
             min_score: f64::NEG_INFINITY,
@@ -283,6 +321,8 @@ impl PedestrianParams {
             ("birth_min_foreground", self.birth_min_foreground),
             ("duplicate_overlap", self.duplicate_overlap),
             ("detection.match_iou", self.detection.match_iou),
+            ("detection.low_match_iou", self.detection.low_match_iou),
+            ("detection.proposal_share", self.detection.proposal_share),
             ("detection.size_smoothing", self.detection.size_smoothing),
             ("proposal.share", self.proposal.share),
             ("proposal.min_iou", self.proposal.min_iou),
@@ -306,6 +346,13 @@ impl PedestrianParams {
                 ));
             }
         }
+        if self.detection.high_score.is_nan() {
+            return Err(Error::parameter(
+                "detection.high_score",
+                self.detection.high_score,
+                "must be a score (default 0.5)",
+            ));
+        }
         if !(self.revive_gate_growth.is_finite() && self.revive_gate_growth >= 0.0) {
             return Err(Error::parameter(
                 "revive_gate_growth",
@@ -324,6 +371,7 @@ impl PedestrianParams {
             ("death_frames", self.death_frames),
             ("unsupported_frames", self.unsupported_frames),
             ("confirm_frames", self.confirm_frames),
+            ("detection.min_hits", self.detection.min_hits),
         ] {
             if frames == 0 {
                 return Err(Error::parameter(key, 0, "must be ≥ 1 frame"));

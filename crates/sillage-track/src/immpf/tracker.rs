@@ -3,9 +3,12 @@
 //! motion histograms (§4.3) or, without images, by the detections, and removed when the mean
 //! likelihood of its particles stays low for some frames (§5.3).
 
+mod on_detections;
+
 use std::collections::VecDeque;
 
 use rayon::prelude::*;
+use sillage_assoc::LapSolver;
 use sillage_core::{Error, FrameIndex, Point2, Result, TrackId, Vec2};
 use sillage_filter::{
     CompetingMotion, ImmParticleFilter, ImmPfSpec, InitialSpread, KinematicModel, Noise2,
@@ -69,10 +72,21 @@ struct Track {
     /// Width and height, px, used where the sizing has no ground plane.
     size_px: (f64, f64),
     low_frames: u32,
-    /// Consecutive frames without a candidate on the tracker's box.
+    /// Consecutive frames without a candidate on the tracker's box (on detections alone:
+    /// without a matched detection).
     unsupported_frames: u32,
     /// The detection matched this frame (detections-only mode).
     matched: Option<BoundingBox>,
+    /// Consecutive frames with a matched detection, the birth included (detections-only
+    /// mode).
+    hit_streak: u32,
+    /// Held by `detection.min_hits` detections in a row once (detections-only mode).
+    confirmed: bool,
+    /// Reported on the frames a detection holds it (detections-only mode): confirmed, and
+    /// not re-confirming after a miss (`detection.reconfirm_after_loss`).
+    reported: bool,
+    /// The frame and foot point of its last matched detection (detections-only mode).
+    last_detection: Option<(FrameIndex, Point2)>,
     bbox: BoundingBox,
     /// Frames lived, the birth frame included.
     age: u32,
@@ -107,6 +121,8 @@ pub struct PedestrianTracker {
     departed: Vec<Departed>,
     next_id: TrackId,
     last_frame: Option<FrameIndex>,
+    /// The assignment solver of the detections-only mode, its buffers reused.
+    solver: LapSolver,
 }
 
 /// A confirmed tracker that died recently: where it was going, so that a birth on its way
@@ -164,6 +180,7 @@ impl PedestrianTracker {
             departed: Vec::new(),
             next_id: 1,
             last_frame: None,
+            solver: LapSolver::new(),
         })
     }
 
@@ -198,68 +215,49 @@ impl PedestrianTracker {
             .filter(|c| c.bbox.is_valid() && c.score >= self.params.detection.min_score)
             .copied()
             .collect();
-        self.predict_and_correct(frame.cues, &candidates);
+        let Some(cues) = frame.cues else {
+            self.step_on_detections(frame.frame, &candidates, out);
+            return Ok(());
+        };
+        self.predict_and_correct(cues, &candidates);
         self.count_support(&candidates);
         self.bury(frame.frame);
-        self.give_birth(frame.frame, frame.cues, &candidates);
+        self.give_birth(frame.frame, cues, &candidates);
         let confirm = self.params.confirm_frames;
         let models = self.models.len();
-        // Detections only: a tracker is reported on the frames a detection confirms it (its
-        // birth or a match), as SORT does; it coasts unreported through missed detections.
-        let coasting_hidden = frame.cues.is_none() && !self.params.detection.report_coasting;
         for track in &mut self.tracks {
             track.age += 1;
             track.remember_foot(frame.frame, confirm);
-            let observed = track.age == 1 || track.matched.is_some();
             if track.age < confirm {
-                if observed || !coasting_hidden {
-                    track.held.push(estimate_of(track, frame.frame, models));
-                }
+                track.held.push(estimate_of(track, frame.frame, models));
             } else {
                 out.append(&mut track.held);
-                if observed || !coasting_hidden {
-                    out.push(estimate_of(track, frame.frame, models));
-                }
+                out.push(estimate_of(track, frame.frame, models));
             }
         }
         Ok(())
     }
 
-    /// Prediction, weighting and resampling of every tracker, in parallel.
-    fn predict_and_correct(&mut self, cues: Option<&FrameCues>, candidates: &[Candidate]) {
+    /// Prediction, weighting by colour and motion (§4.3) and resampling of every tracker, in
+    /// parallel.
+    fn predict_and_correct(&mut self, cues: &FrameCues, candidates: &[Candidate]) {
         let models = &self.models;
         self.tracks
             .par_iter_mut()
             .for_each(|track| track.filter.predict(models));
-        if cues.is_none() {
-            self.match_detections(candidates);
-        } else {
-            self.propose_on_blobs(candidates);
-        }
+        self.propose_on_blobs(candidates);
         let (params, sizing) = (&self.params, &self.sizing);
         let death = params.death_log_likelihood.exp();
         self.tracks
             .par_iter_mut()
             .for_each_init(HistogramScratch::default, |scratch, track| {
                 let size = track.size_px;
-                let weighting = match (cues, &track.appearance, track.matched) {
-                    (Some(cues), Some(appearance), _) => track.filter.weight(|p| {
+                let weighting = match &track.appearance {
+                    Some(appearance) => track.filter.weight(|p| {
                         let b = sizing.box_at(p.pos_px, size);
                         appearance.log_likelihood(&params.appearance, cues, &b, scratch)
                     }),
-                    (None, _, Some(detection)) => {
-                        let foot = detection.foot();
-                        let sigma =
-                            (params.detection.foot_sigma_fraction * detection.height_px).max(1.0);
-                        let scale = 0.5 / (sigma * sigma);
-                        track
-                            .filter
-                            .weight(|p| -scale * (p.pos_px - foot).norm_squared())
-                    }
-                    _ => {
-                        let missed = params.detection.missed_log_likelihood;
-                        track.filter.weight(|_| missed)
-                    }
+                    None => track.filter.weight(|_| 0.0),
                 };
                 track.filter.resample();
                 if weighting.mean_likelihood < death {
@@ -269,29 +267,10 @@ impl PedestrianTracker {
                 }
                 let foot = estimate_foot(&track.filter);
                 track.bbox = sizing.box_at(foot, track.size_px);
-                if let (Some(cues), Some(appearance)) = (cues, &mut track.appearance) {
+                if let Some(appearance) = &mut track.appearance {
                     appearance.adapt(&params.appearance, cues, &track.bbox, scratch);
                 }
             });
-    }
-
-    /// Detections-only mode: each detection goes to the tracker whose predicted box it
-    /// overlaps most (greedy by IoU, at least `match_iou`); a matched tracker's size follows
-    /// its detections.
-    fn match_detections(&mut self, candidates: &[Candidate]) {
-        let boxes: Vec<BoundingBox> = candidates.iter().map(|c| c.bbox).collect();
-        let pairs = self.match_predicted(&boxes, self.params.detection.match_iou);
-        self.tracks.iter_mut().for_each(|t| t.matched = None);
-        let alpha = self.params.detection.size_smoothing;
-        for (t, d) in pairs {
-            let detection = boxes[d];
-            let track = &mut self.tracks[t];
-            track.matched = Some(detection);
-            track.size_px = (
-                (1.0 - alpha) * track.size_px.0 + alpha * detection.width_px,
-                (1.0 - alpha) * track.size_px.1 + alpha * detection.height_px,
-            );
-        }
     }
 
     /// Image mode: the motion blobs' people (`BoxSizing::people_in`) matched to the trackers
@@ -446,19 +425,12 @@ impl PedestrianTracker {
     }
 
     /// Starts a tracker on every candidate that no live tracker explains.
-    fn give_birth(
-        &mut self,
-        frame: FrameIndex,
-        cues: Option<&FrameCues>,
-        candidates: &[Candidate],
-    ) {
-        let init_pos = self.params.init_pos_noise_px.powi(2);
-        let init_vel = self.params.init_vel_noise_px_per_frame.powi(2);
+    fn give_birth(&mut self, frame: FrameIndex, cues: &FrameCues, candidates: &[Candidate]) {
         for candidate in candidates {
-            let explained = self.tracks.iter().any(|t| {
-                t.matched == Some(candidate.bbox)
-                    || t.bbox.iou(&candidate.bbox) >= self.params.birth_overlap
-            });
+            let explained = self
+                .tracks
+                .iter()
+                .any(|t| t.bbox.iou(&candidate.bbox) >= self.params.birth_overlap);
             if explained {
                 continue;
             }
@@ -469,54 +441,68 @@ impl PedestrianTracker {
                 }) {
                     continue;
                 }
-                let appearance = match cues {
-                    Some(cues) => {
-                        match Appearance::capture(&self.params.appearance, cues, &person) {
-                            Some(appearance)
-                                if appearance.moving_share().unwrap_or(0.0)
-                                    >= self.params.birth_min_motion
-                                    && cues.foreground_share(&person).unwrap_or(1.0)
-                                        >= self.params.birth_min_foreground =>
-                            {
-                                Some(appearance)
-                            }
-                            _ => continue,
-                        }
+                let appearance = match Appearance::capture(&self.params.appearance, cues, &person) {
+                    Some(appearance)
+                        if appearance.moving_share().unwrap_or(0.0)
+                            >= self.params.birth_min_motion
+                            && cues.foreground_share(&person).unwrap_or(1.0)
+                                >= self.params.birth_min_foreground =>
+                    {
+                        appearance
                     }
-                    None => None,
+                    _ => continue,
                 };
-                let spread = InitialSpread {
-                    pos_px: person.foot(),
-                    pos_noise: Noise2::diagonal(init_pos, init_pos)
-                        .factor("init_pos_noise_px")
-                        .expect("validated σ"),
-                    vel_px_per_frame: Vec2::new(0.0, 0.0),
-                    vel_noise: Noise2::diagonal(init_vel, init_vel)
-                        .factor("init_vel_noise_px_per_frame")
-                        .expect("validated σ"),
-                    mode: 0,
-                };
-                let (track_id, age) = match self.revive(frame, &person, cues.is_some()) {
+                let (track_id, age) = match self.revive(frame, &person) {
                     Some(track_id) => (track_id, self.params.confirm_frames),
                     None => {
                         self.next_id += 1;
                         (self.next_id - 1, 0)
                     }
                 };
-                self.tracks.push(Track {
-                    id: track_id,
-                    filter: self.spec.spawn(track_id, &spread),
-                    appearance,
-                    size_px: (person.width_px, person.height_px),
-                    low_frames: 0,
-                    unsupported_frames: 0,
-                    matched: None,
-                    bbox: person,
-                    age,
-                    held: Vec::new(),
-                    recent_feet: VecDeque::new(),
-                });
+                let track = self.spawn(track_id, &person, Some(appearance), age);
+                self.tracks.push(track);
             }
+        }
+    }
+
+    /// A new tracker `track_id` on `person` (its particles around the foot point, at rest),
+    /// `age` frames old.
+    fn spawn(
+        &self,
+        track_id: TrackId,
+        person: &BoundingBox,
+        appearance: Option<Appearance>,
+        age: u32,
+    ) -> Track {
+        let init_pos = self.params.init_pos_noise_px.powi(2);
+        let init_vel = self.params.init_vel_noise_px_per_frame.powi(2);
+        let spread = InitialSpread {
+            pos_px: person.foot(),
+            pos_noise: Noise2::diagonal(init_pos, init_pos)
+                .factor("init_pos_noise_px")
+                .expect("validated σ"),
+            vel_px_per_frame: Vec2::new(0.0, 0.0),
+            vel_noise: Noise2::diagonal(init_vel, init_vel)
+                .factor("init_vel_noise_px_per_frame")
+                .expect("validated σ"),
+            mode: 0,
+        };
+        Track {
+            id: track_id,
+            filter: self.spec.spawn(track_id, &spread),
+            appearance,
+            size_px: (person.width_px, person.height_px),
+            low_frames: 0,
+            unsupported_frames: 0,
+            matched: None,
+            hit_streak: 0,
+            confirmed: false,
+            reported: false,
+            last_detection: None,
+            bbox: *person,
+            age,
+            held: Vec::new(),
+            recent_feet: VecDeque::new(),
         }
     }
 }
@@ -524,21 +510,16 @@ impl PedestrianTracker {
 impl PedestrianTracker {
     /// The identity of the departed tracker whose extrapolated (or last) foot point is
     /// nearest to `person`'s, relative to its gate ([`revival_gate`]); removed from the
-    /// departed. `on_images`: the trackers are weighed on frames (not detections alone).
-    fn revive(
-        &mut self,
-        frame: FrameIndex,
-        person: &BoundingBox,
-        on_images: bool,
-    ) -> Option<TrackId> {
+    /// departed.
+    fn revive(&mut self, frame: FrameIndex, person: &BoundingBox) -> Option<TrackId> {
         let foot = person.foot();
         let (k, _) = self
             .departed
             .iter()
             .enumerate()
             .map(|(k, d)| {
-                let gate = revival_gate(&self.params, frame - d.frame, on_images);
-                let distance = revival_distance(d, frame, foot, on_images);
+                let gate = revival_gate(&self.params, frame - d.frame);
+                let distance = revival_distance(d, frame, foot);
                 (k, distance / (gate * person.height_px))
             })
             .filter(|&(_, relative)| relative <= 1.0)
@@ -548,27 +529,21 @@ impl PedestrianTracker {
 }
 
 /// The radius, in box heights, within which a person born `elapsed` frames after a tracker's
-/// death takes its identity back: half a height, widened on images by
-/// `revive_gate_growth` per frame up to `revive_gate_max`. The dying tracker's velocity is
-/// least reliable when it lost its person (it lagged behind a walker who went behind
-/// others), so the farther the person may have walked since, the wider the gate. On
-/// detections alone it stays at half a height: a tracker there has already coasted on its
-/// prediction for `unsupported_frames` frames before it died (docs/immpf.md).
-fn revival_gate(params: &PedestrianParams, elapsed: FrameIndex, on_images: bool) -> f64 {
-    if !on_images {
-        return REVIVAL_GATE_AT_DEATH;
-    }
+/// death takes its identity back: half a height, widened by `revive_gate_growth` per frame
+/// up to `revive_gate_max`. The dying tracker's velocity is least reliable when it lost its
+/// person (it lagged behind a walker who went behind others), so the farther the person may
+/// have walked since, the wider the gate (docs/immpf.md).
+fn revival_gate(params: &PedestrianParams, elapsed: FrameIndex) -> f64 {
     (REVIVAL_GATE_AT_DEATH + params.revive_gate_growth * elapsed as f64).min(params.revive_gate_max)
 }
 
 /// How far `foot` lies, at `frame`, from where the departed tracker `d` would be: the
-/// nearest of its foot point when it died and, on images (`on_images`), its last reported
-/// one, each as it stood and extrapolated by its velocity. On images the estimate of the
-/// frame it died in comes from a weighting that failed and may have jumped off its path; on
-/// detections alone it is a coasting prediction like those before it. The velocity of a
-/// tracker that was losing its person may be wrong, hence the unextrapolated points too.
-fn revival_distance(d: &Departed, frame: FrameIndex, foot: Point2, on_images: bool) -> f64 {
-    let reported = d.recent_feet.last().copied().filter(|_| on_images);
+/// nearest of its foot point when it died and its last reported one, each as it stood and
+/// extrapolated by its velocity: the estimate of the frame it died in comes from a weighting
+/// that failed and may have jumped off its path, and the velocity of a tracker that was
+/// losing its person may be wrong, hence the unextrapolated points too.
+fn revival_distance(d: &Departed, frame: FrameIndex, foot: Point2) -> f64 {
+    let reported = d.recent_feet.last().copied();
     [(d.frame, d.foot)]
         .into_iter()
         .chain(reported)
@@ -678,7 +653,7 @@ mod tests {
     }
 
     #[test]
-    fn revival_looks_from_the_last_reported_foot_on_images_only() {
+    fn revival_looks_from_the_last_reported_foot_too() {
         // Reported at x = 700 in frame 121 while walking left 5 px a frame; in frame 122,
         // the one it died in, its estimate jumped back to x = 730.
         let departed = Departed {
@@ -694,29 +669,27 @@ mod tests {
         // A birth at x = 680 in frame 123: 10 px from the reported foot extrapolated by two
         // frames (690), 45 px from the dying estimate extrapolated by one (725).
         let born = Point2::new(680.0, 300.0);
-        assert_eq!(revival_distance(&departed, 123, born, true), 10.0);
-        assert_eq!(revival_distance(&departed, 123, born, false), 45.0);
+        assert_eq!(revival_distance(&departed, 123, born), 10.0);
         // Without any reported foot, the dying estimate alone.
         let alone = Departed {
             recent_feet: Vec::new(),
             ..departed
         };
-        assert_eq!(revival_distance(&alone, 123, born, true), 45.0);
+        assert_eq!(revival_distance(&alone, 123, born), 45.0);
     }
 
     #[test]
-    fn the_revival_gate_widens_with_time_on_images_only() {
+    fn the_revival_gate_widens_with_time() {
         let params = PedestrianParams::default();
         // Half a height at the death; a walker's pace (0.1 height a frame) after it, up to
-        // 1.5 heights; half a height throughout on detections alone.
-        assert_eq!(revival_gate(&params, 0, true), 0.5);
-        assert!((revival_gate(&params, 5, true) - 1.0).abs() < 1e-12);
-        assert_eq!(revival_gate(&params, 20, true), 1.5);
-        assert_eq!(revival_gate(&params, 5, false), 0.5);
+        // 1.5 heights.
+        assert_eq!(revival_gate(&params, 0), 0.5);
+        assert!((revival_gate(&params, 5) - 1.0).abs() < 1e-12);
+        assert_eq!(revival_gate(&params, 20), 1.5);
         let still = PedestrianParams {
             revive_gate_growth: 0.0,
             ..params
         };
-        assert_eq!(revival_gate(&still, 20, true), 0.5);
+        assert_eq!(revival_gate(&still, 20), 0.5);
     }
 }

@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""Leave-one-sequence-out choice of the IMM-PF's detections-only life cycle.
+
+Runs `sillage bench immpf --detections-only` for every combination of the life-cycle
+switches below on every sequence given, then, for each sequence in turn, picks the
+combination with the best mean (MOTA + IDF1) / 2 on the *other* sequences and reports what
+that pick scores on the held-out one, beside SORT and ByteTrack in the same harness. The
+figures this prints are the only ones docs/immpf.md quotes for the choice: none of them was
+seen by the choice it reports.
+
+    python3 tools/immpf_loso.py --sillage target/release/sillage \
+        ../shared/data/mot15_train_gt_det/*/ ../shared/data/pets09_s2l1
+
+Standard library only; the binary does the tracking and the scoring.
+"""
+
+import argparse
+import itertools
+import json
+import subprocess
+import sys
+
+SWITCHES = {
+    "detection.lost_frames": [1, 30],
+    "detection.velocity_proposal": ["true", "false"],
+    "detection.reconfirm_after_loss": ["true", "false"],
+    "detection.report_first_hits": ["true", "false"],
+}
+
+
+def bench(sillage, sequences, settings, models, runs):
+    """{sequence: {label: (mota, idf1)}} for one combination (label "IMM-PF"), plus the
+    baselines' rows under their own labels."""
+    command = [sillage, "bench", "immpf", "--detections-only", "--json",
+               "--models", models, "--runs", str(runs)]
+    for key, value in settings:
+        command += ["--set", f"tracker.{key}={value}"]
+    done = subprocess.run(command + sequences, capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"{' '.join(command)} failed:\n{done.stderr}")
+    scores = {}
+    for row in json.loads(done.stdout):
+        label = row["models"] if row["models"] in ("SORT", "ByteTrack") else "IMM-PF"
+        median = row["median"]
+        scores.setdefault(row["sequence"], {})[label] = (median["mota"], median["idf1"])
+    return scores
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("sequences", nargs="+", help="MOTChallenge sequence folders")
+    parser.add_argument("--sillage", default="target/release/sillage")
+    parser.add_argument("--models", default="CV")
+    parser.add_argument("--runs", type=int, default=3)
+    args = parser.parse_args()
+    sequences = [s for s in args.sequences if not s.endswith(".md")]
+
+    combos = [tuple(zip(SWITCHES, values)) for values in itertools.product(*SWITCHES.values())]
+    results = {}
+    for combo in combos:
+        results[combo] = bench(args.sillage, sequences, combo, args.models, args.runs)
+        print("measured", ", ".join(f"{k}={v}" for k, v in combo), file=sys.stderr)
+    names = sorted(next(iter(results.values())))
+
+    def objective(combo, names_in):
+        pairs = [results[combo][n]["IMM-PF"] for n in names_in]
+        return sum((m + i) / 2 for m, i in pairs) / len(pairs)
+
+    print("| held out | chosen on the others | IMM-PF MOTA / IDF1 | SORT | ByteTrack |")
+    print("|---|---|---|---|---|")
+    picks = {}
+    for held in names:
+        others = [n for n in names if n != held]
+        best = max(combos, key=lambda c: objective(c, others))
+        picks[best] = picks.get(best, 0) + 1
+        row = results[best][held]
+        label = ", ".join(f"{k.split('.')[1]}={v}" for k, v in best)
+        cells = [f"{row[k][0]:.1f} / {row[k][1]:.1f}" for k in ("IMM-PF", "SORT", "ByteTrack")]
+        print(f"| {held} | {label} | " + " | ".join(cells) + " |")
+    print()
+    for combo, count in sorted(picks.items(), key=lambda kv: -kv[1]):
+        print(f"chosen {count}×:", ", ".join(f"{k}={v}" for k, v in combo))
+
+
+if __name__ == "__main__":
+    main()
