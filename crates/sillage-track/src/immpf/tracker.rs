@@ -104,6 +104,16 @@ impl Track {
         }
         self.recent_feet.push_back((frame, self.bbox.foot()));
     }
+
+    /// True while its foot point is in a frame of `frame_size_px` (width, height), or below
+    /// it by less than half the box (a person walking out at the bottom edge).
+    fn foot_inside(&self, frame_size_px: (usize, usize)) -> bool {
+        let foot = self.bbox.foot();
+        foot.x >= 0.0
+            && foot.x < frame_size_px.0 as f64
+            && foot.y >= 0.0
+            && foot.y < frame_size_px.1 as f64 + self.bbox.height_px / 2.0
+    }
 }
 
 /// The pedestrian IMM-PF tracker. Each filter draws from its own stream
@@ -352,17 +362,13 @@ impl PedestrianTracker {
     /// the younger of two that follow one person.
     fn bury(&mut self, frame: FrameIndex) {
         let unsupported = self.params.unsupported_frames;
-        let (width, height) = (self.frame_size_px.0 as f64, self.frame_size_px.1 as f64);
+        let frame_size = self.frame_size_px;
         let death_frames = self.params.death_frames;
         let (confirm, revive) = (self.params.confirm_frames, self.params.revive_frames);
         let departed = &mut self.departed;
         departed.retain(|d| frame - d.frame <= u64::from(revive));
         self.tracks.retain(|t| {
-            let foot = t.bbox.foot();
-            let inside = foot.x >= 0.0
-                && foot.x < width
-                && foot.y >= 0.0
-                && foot.y < height + t.bbox.height_px / 2.0;
+            let inside = t.foot_inside(frame_size);
             let alive = t.low_frames < death_frames && t.unsupported_frames < unsupported;
             if inside && !alive && t.age >= confirm && revive > 0 {
                 departed.push(Departed::of(t, frame));

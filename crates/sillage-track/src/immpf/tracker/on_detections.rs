@@ -176,16 +176,10 @@ impl PedestrianTracker {
     /// Ends the tentative trackers that missed their detection, the confirmed ones that
     /// went `lost_frames` frames without one, and those whose foot left the image.
     fn end_lost_trackers(&mut self) {
-        let lost = self.params.detection.lost_frames;
-        let (width, height) = (self.frame_size_px.0 as f64, self.frame_size_px.1 as f64);
+        let (lost, frame_size) = (self.params.detection.lost_frames, self.frame_size_px);
         self.tracks.retain(|t| {
-            let foot = t.bbox.foot();
-            let inside = foot.x >= 0.0
-                && foot.x < width
-                && foot.y >= 0.0
-                && foot.y < height + t.bbox.height_px / 2.0;
             let limit = if t.confirmed { lost } else { 0 };
-            inside && t.unsupported_frames <= limit
+            t.foot_inside(frame_size) && t.unsupported_frames <= limit
         });
     }
 
