@@ -2,7 +2,7 @@
 """Leave-one-sequence-out choice of the IMM-PF's detections-only life cycle.
 
 Runs `sillage bench immpf --detections-only` for every combination of the life-cycle
-switches below on every sequence given, then, for each sequence in turn, picks the
+switches and smoothings below on every sequence given, then, for each sequence in turn, picks the
 combination with the best mean (MOTA + IDF1) / 2 on the *other* sequences and reports what
 that pick scores on the held-out one, beside SORT and ByteTrack in the same harness. The
 figures this prints are the only ones docs/immpf.md quotes for the choice: none of them was
@@ -21,10 +21,11 @@ import subprocess
 import sys
 
 SWITCHES = {
-    "detection.lost_frames": [1, 30],
-    "detection.velocity_proposal": ["true", "false"],
-    "detection.reconfirm_after_loss": ["true", "false"],
+    "detection.lost_frames": [1, 5, 30],
+    "detection.min_hits": [3, 4, 5],
     "detection.report_first_hits": ["true", "false"],
+    "detection.velocity_proposal": ["true", "false"],
+    "detection.size_smoothing": [0.3, 0.7],
 }
 
 
@@ -50,12 +51,21 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("sequences", nargs="+", help="MOTChallenge sequence folders")
     parser.add_argument("--sillage", default="target/release/sillage")
-    parser.add_argument("--models", default="CV")
+    parser.add_argument("--models", default="CV_CA")
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2",
+                        help="replace the grid of the switches named (repeatable), e.g. "
+                             "detection.min_hits=5,6,7; KEY=V alone fixes a switch")
     args = parser.parse_args()
+    grid = dict(SWITCHES)
+    for item in args.grid:
+        key, _, values = item.partition("=")
+        if not values:
+            sys.exit(f"--grid {item}: write KEY=V1,V2")
+        grid[key] = values.split(",")
     sequences = [s for s in args.sequences if not s.endswith(".md")]
 
-    combos = [tuple(zip(SWITCHES, values)) for values in itertools.product(*SWITCHES.values())]
+    combos = [tuple(zip(grid, values)) for values in itertools.product(*grid.values())]
     results = {}
     for combo in combos:
         results[combo] = bench(args.sillage, sequences, combo, args.models, args.runs)

@@ -254,9 +254,11 @@ impl ImmParticleFilter {
     }
 
     /// [`Self::propose_near`] that also draws the moved particles' velocities from
-    /// `N(velocity, vel_sd² I)` (px/frame): where an observation gives the motion too (two
-    /// detections of one person), a filter whose particles have not learnt the person's
-    /// speed yet gets hypotheses that move with it.
+    /// `N(velocity, vel_sd² I)` (px/frame) and sets their accelerations to zero: where an
+    /// observation gives the motion too (two detections of one person), a filter whose
+    /// particles have not learnt the person's speed yet gets hypotheses that move with it,
+    /// without the accelerations of the few ancestors a sharp likelihood leaves, which would
+    /// bend every hypothesis alike while the target goes unobserved.
     pub fn propose_moving_near(
         &mut self,
         share: f64,
@@ -286,6 +288,12 @@ impl ImmParticleFilter {
                     let (dx, dy) = normals.pair();
                     columns.vel_x[i] = v.x + sd * dx;
                     columns.vel_y[i] = v.y + sd * dy;
+                    if let (Some(ax), Some(ay)) =
+                        (columns.acc_x.get_mut(i), columns.acc_y.get_mut(i))
+                    {
+                        *ax = 0.0;
+                        *ay = 0.0;
+                    }
                 }
             }
         }

@@ -526,9 +526,9 @@ fn identities(estimates: &[PedestrianEstimate]) -> Vec<u64> {
     ids
 }
 
-/// On detections alone a tracker is reported once `min_hits` (3) detections in a row held it,
-/// from that frame on: a walker from frame 2, and false detections of one or two frames
-/// never; with `report_first_hits` the walker's first two frames too.
+/// On detections alone a tracker is reported once `min_hits` (here 3) detections in a row
+/// held it, from that frame on: a walker from frame 2, and false detections of one or two
+/// frames never; with `report_first_hits` the walker's first two frames too.
 #[test]
 fn detections_alone_report_a_tracker_after_three_matches_in_a_row() {
     let walker = |f: u64| (40.0 + 2.0 * f as f64, 120.0, 0.9);
@@ -539,16 +539,20 @@ fn detections_alone_report_a_tracker_after_three_matches_in_a_row() {
         }
         boxes
     };
-    let params = PedestrianParams::default();
+    let mut params = PedestrianParams::default();
+    params.detection.min_hits = 3;
+    params.detection.report_first_hits = false;
     let out = on_detections(&params, 40, scene);
     assert_eq!(identities(&out).len(), 1, "{:?}", identities(&out));
     assert_eq!(out.iter().map(|e| e.frame).min(), Some(2));
     assert_eq!(out.len(), 38);
-    let mut early = params.clone();
-    early.detection.report_first_hits = true;
-    let out = on_detections(&early, 40, scene);
+    params.detection.report_first_hits = true;
+    let out = on_detections(&params, 40, scene);
     assert_eq!(out.iter().map(|e| e.frame).min(), Some(0));
     assert_eq!(out.len(), 40);
+    // A false streak as long as `min_hits` is reported, one shorter is not.
+    params.detection.min_hits = 2;
+    assert_eq!(identities(&on_detections(&params, 40, scene)).len(), 2);
 }
 
 /// A walker the detector misses for 10 frames keeps its identity within `lost_frames` (30):
@@ -566,8 +570,16 @@ fn a_walker_missed_for_ten_frames_keeps_its_identity() {
     let params = PedestrianParams::default();
     let out = on_detections(&params, 60, scene);
     assert_eq!(identities(&out).len(), 1, "{:?}", identities(&out));
-    // Unreported while missed, and while it re-confirms (3 matches: frames 30-32).
-    assert!(out.iter().all(|e| !(20..32).contains(&e.frame)));
+    // Unreported while missed; re-confirmed after `min_hits` new matches, frames 30 on then
+    // reported with `report_first_hits`, from frame 29 + `min_hits` without.
+    let hits = params.detection.min_hits as u64;
+    let first_back = if params.detection.report_first_hits {
+        30
+    } else {
+        29 + hits
+    };
+    assert!(out.iter().all(|e| !(20..first_back).contains(&e.frame)));
+    assert!(out.iter().any(|e| e.frame == first_back));
     assert!(out.iter().any(|e| e.frame == 59));
     let short = PedestrianParams {
         detection: sillage_track::immpf::DetectionLikelihoodParams {
@@ -595,12 +607,14 @@ fn weak_detections_hold_a_tracked_walker_and_start_none() {
 
 /// A walker detected every frame at 8 px a frame, its box 16 px wide: the particles, born
 /// at rest, take the walker's velocity from its first two detections and keep it (one
-/// identity, reported from frame 2, every seed); without that proposal the predicted box
+/// identity, reported from its third detection, every seed); without that proposal the predicted box
 /// falls behind the detections and the walker's track breaks up (measured: 5 of 5 seeds).
 #[test]
 fn the_first_two_detections_give_a_fast_walker_its_velocity() {
     let scene = |f: u64| vec![(20.0 + 8.0 * f as f64, 120.0, 0.9)];
-    let params = PedestrianParams::default();
+    let mut params = PedestrianParams::default();
+    params.detection.min_hits = 3;
+    params.detection.report_first_hits = false;
     let mut still = params.clone();
     still.detection.velocity_proposal = false;
     let mut broken = 0;

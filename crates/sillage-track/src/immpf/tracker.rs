@@ -87,6 +87,9 @@ struct Track {
     reported: bool,
     /// The frame and foot point of its last matched detection (detections-only mode).
     last_detection: Option<(FrameIndex, Point2)>,
+    /// The velocity of its detections, smoothed over the streak, px/frame
+    /// (detections-only mode, `detection.velocity_proposal`).
+    detection_velocity: Option<Vec2>,
     bbox: BoundingBox,
     /// Frames lived, the birth frame included.
     age: u32,
@@ -505,6 +508,7 @@ impl PedestrianTracker {
             confirmed: false,
             reported: false,
             last_detection: None,
+            detection_velocity: None,
             bbox: *person,
             age,
             held: Vec::new(),

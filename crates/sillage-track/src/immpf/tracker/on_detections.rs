@@ -10,18 +10,20 @@
 //! on the frames a detection holds it.
 
 use rayon::prelude::*;
-use sillage_core::{BoundingBox, FrameIndex};
+use sillage_core::{BoundingBox, FrameIndex, Point2};
 
-use super::{Candidate, PedestrianEstimate, PedestrianTracker, estimate_foot, estimate_of};
+use super::{Candidate, PedestrianEstimate, PedestrianTracker, Track, estimate_foot, estimate_of};
 use crate::bytetrack::assign;
+use crate::immpf::DetectionLikelihoodParams;
 
-/// σ of the velocities the proposal draws from two detections `elapsed` frames apart, as a
-/// multiple of `σ / elapsed` (σ the foot likelihood's): half of it, where the difference of
-/// two independent foot points would have √2. A velocity this noisy is proposed only at the
-/// first match of a streak, and the models smooth it from then on. Chosen with the
-/// velocity proposal on all nine detection sequences (0.2, 0.5 and √2 tried: 0.2 and 0.5
-/// within 0.5 point of mean (MOTA + IDF1)/2, √2 about 1 point below); no held-out figure.
-const VELOCITY_PROPOSAL_SD: f64 = 0.5;
+/// σ of the velocities the proposal draws around the detections' velocity, as a multiple of
+/// `σ / elapsed` (σ the foot likelihood's, `elapsed` the frames between the two detections):
+/// the difference of two independent foot points would have √2; the smoothing over a streak
+/// makes it smaller. Tried on all nine detection sequences, not held out (0.2, 0.5 and √2,
+/// with the velocity drawn at the first match of a streak only: 0.2 and 0.5 within 0.5 point
+/// of mean (MOTA + IDF1) / 2, √2 about 1 point below; smoothed at every match with weight
+/// 0.2: 0.2 half a point above 0.5).
+const VELOCITY_PROPOSAL_SD: f64 = 0.2;
 
 impl PedestrianTracker {
     /// One frame of the detections-only mode ([`PedestrianTracker::step`] without cues).
@@ -120,40 +122,22 @@ impl PedestrianTracker {
 
     /// Weighs every tracker's particles: a Gaussian of the foot-point distance to its
     /// detection (σ = `foot_sigma_fraction` × the detection's height) after a share
-    /// `proposal_share` of them was drawn around that foot point; a constant without one
-    /// (the prediction stands). Counts matches in a row and frames without one, and lets
+    /// `proposal_share` of them was drawn around that foot point ([`propose_on_detection`]);
+    /// a constant without one (the prediction stands). Counts matches in a row and frames without one, and lets
     /// the box size follow the detections.
     fn correct_on_detections(&mut self, frame: FrameIndex) {
         let (params, sizing) = (&self.params.detection, &self.sizing);
-        let missed = params.missed_log_likelihood;
         self.tracks.par_iter_mut().for_each(|track| {
             match track.matched {
                 Some(detection) => {
                     let foot = detection.foot();
                     let sigma = (params.foot_sigma_fraction * detection.height_px).max(1.0);
-                    // The second detection of a tracker, or the first after a miss, gives
-                    // its velocity, as the second update of SORT's filter does.
-                    let first_of_streak = track.hit_streak <= 1;
-                    match track.last_detection {
-                        Some((then, before)) if params.velocity_proposal && first_of_streak => {
-                            let elapsed = (frame - then) as f64;
-                            track.filter.propose_moving_near(
-                                params.proposal_share,
-                                foot,
-                                sigma,
-                                (foot - before) / elapsed,
-                                VELOCITY_PROPOSAL_SD * sigma / elapsed,
-                            )
-                        }
-                        _ => track
-                            .filter
-                            .propose_near(params.proposal_share, foot, sigma),
-                    }
-                    track.last_detection = Some((frame, foot));
+                    propose_on_detection(track, foot, sigma, frame, params);
                     let scale = 0.5 / (sigma * sigma);
                     track
                         .filter
                         .weight(|p| -scale * (p.pos_px - foot).norm_squared());
+                    track.filter.resample();
                     let alpha = params.size_smoothing;
                     track.size_px = (
                         (1.0 - alpha) * track.size_px.0 + alpha * detection.width_px,
@@ -163,12 +147,12 @@ impl PedestrianTracker {
                     track.unsupported_frames = 0;
                 }
                 None => {
-                    track.filter.weight(|_| missed);
+                    // No likelihood: the weights stay as they are, and no resampling, which
+                    // would only thin out the particles' velocities while the tracker coasts.
                     track.hit_streak = 0;
                     track.unsupported_frames += 1;
                 }
             }
-            track.filter.resample();
             track.bbox = sizing.box_at(estimate_foot(&track.filter), track.size_px);
         });
     }
@@ -216,4 +200,45 @@ impl PedestrianTracker {
             }
         }
     }
+}
+
+/// Draws `proposal_share` of a matched tracker's particles around its detection's foot point
+/// `foot` (σ `sigma`) and, with `velocity_proposal`, their velocities around the detections'
+/// velocity: the difference of its last two detections' foot points per frame, smoothed
+/// exponentially (`velocity_smoothing`) over a streak of matches and taken as it is at the
+/// streak's first (a tracker's second detection, or its first after a miss) — as the second
+/// update of SORT's Kalman filter takes the velocity at once and its small process noise
+/// then smooths it.
+fn propose_on_detection(
+    track: &mut Track,
+    foot: Point2,
+    sigma: f64,
+    frame: FrameIndex,
+    params: &DetectionLikelihoodParams,
+) {
+    let share = params.proposal_share;
+    let measured = track
+        .last_detection
+        .filter(|_| params.velocity_proposal)
+        .map(|(then, before)| {
+            let elapsed = (frame - then) as f64;
+            ((foot - before) / elapsed, elapsed)
+        });
+    match measured {
+        Some((velocity, elapsed)) => {
+            let smoothed = match track.detection_velocity {
+                Some(old) if track.hit_streak > 1 => {
+                    old + (velocity - old) * params.velocity_smoothing
+                }
+                _ => velocity,
+            };
+            track.detection_velocity = Some(smoothed);
+            let vel_sd = VELOCITY_PROPOSAL_SD * sigma / elapsed;
+            track
+                .filter
+                .propose_moving_near(share, foot, sigma, smoothed, vel_sd);
+        }
+        None => track.filter.propose_near(share, foot, sigma),
+    }
+    track.last_detection = Some((frame, foot));
 }
