@@ -4,9 +4,9 @@
 Runs `sillage bench immpf --detections-only` for every combination of the life-cycle
 switches and smoothings below on every sequence given, then, for each sequence in turn, picks the
 combination with the best mean (MOTA + IDF1) / 2 on the *other* sequences and reports what
-that pick scores on the held-out one, beside SORT and ByteTrack in the same harness. The
-figures this prints are the only ones docs/immpf.md quotes for the choice: none of them was
-seen by the choice it reports.
+that pick scores on the held-out one, beside SORT and ByteTrack in the same harness: figures
+that the choice each row reports never saw (docs/immpf.md quotes them). `--grid` replaces
+the values tried for a switch.
 
     python3 tools/immpf_loso.py --sillage target/release/sillage \
         ../shared/data/mot15_train_gt_det/*/ ../shared/data/pets09_s2l1
