@@ -26,6 +26,7 @@ SWITCHES = {
     "detection.report_first_hits": ["true", "false"],
     "detection.velocity_proposal": ["true", "false"],
     "detection.size_smoothing": [0.3, 0.7],
+    "detection.high_score": [0.5, 0.7, 0.9],
 }
 
 

@@ -555,9 +555,9 @@ fn detections_alone_report_a_tracker_after_three_matches_in_a_row() {
     assert_eq!(identities(&on_detections(&params, 40, scene)).len(), 2);
 }
 
-/// A walker the detector misses for 10 frames keeps its identity within `lost_frames` (30):
+/// A walker the detector misses for 10 frames keeps its identity within `lost_frames` = 30:
 /// its tracker coasts on its velocity, unreported, and takes the detection back; with
-/// `lost_frames` = 5 the walker comes back under a new identity.
+/// `lost_frames` = 5 (the default) the walker comes back under a new identity.
 #[test]
 fn a_walker_missed_for_ten_frames_keeps_its_identity() {
     let scene = |f: u64| {
@@ -567,7 +567,8 @@ fn a_walker_missed_for_ten_frames_keeps_its_identity() {
             vec![(40.0 + 2.0 * f as f64, 120.0, 0.9)]
         }
     };
-    let params = PedestrianParams::default();
+    let mut params = PedestrianParams::default();
+    params.detection.lost_frames = 30;
     let out = on_detections(&params, 60, scene);
     assert_eq!(identities(&out).len(), 1, "{:?}", identities(&out));
     // Unreported while missed; re-confirmed after `min_hits` new matches, frames 30 on then

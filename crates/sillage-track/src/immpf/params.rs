@@ -78,12 +78,14 @@ impl ModelName {
 /// weigh the particles, and the trackers' life cycle there (the image mode's
 /// `confirm_frames`, `unsupported_frames`, revival and death rules do not apply).
 ///
-/// `min_hits`, `lost_frames`, `report_first_hits`, `velocity_proposal` and `size_smoothing`
-/// were chosen together leave-one-sequence-out on the nine shared detection sequences (the
-/// eight MOT15 training sequences and PETS09-S2L1 frames 1-150; `tools/immpf_loso.py`,
-/// docs/immpf.md): each sequence held out in turn, the best combination on the other eight
-/// was the same in all nine folds, and scored on the held-out ones a mean (MOTA + IDF1) / 2
-/// of 52.8 % (SORT 52.0, ByteTrack 49.5, this mode before the choice 41.5).
+/// `high_score`, `min_hits`, `lost_frames`, `report_first_hits`, `velocity_proposal` and
+/// `size_smoothing` were chosen together leave-one-sequence-out on the nine shared detection
+/// sequences (the eight MOT15 training sequences and PETS09-S2L1 frames 1-150, public ACF
+/// detections; `tools/immpf_loso.py`, docs/immpf.md): each sequence held out in turn, the
+/// best of 216 combinations on the other eight, scored on the held-out one, gave a mean
+/// (MOTA + IDF1) / 2 of 55.0 % (SORT 52.0, ByteTrack 49.5, this mode before 41.5); the
+/// defaults are the combination seven folds chose (the other two differ in `lost_frames`
+/// only: 30).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DetectionLikelihoodParams {
@@ -92,7 +94,9 @@ pub struct DetectionLikelihoodParams {
     pub match_iou: f64,
     /// Detections of at least this score are assigned first, to every tracker, and start
     /// trackers; the others are assigned second, to the trackers a detection held in the
-    /// previous frame, and start none (ByteTrack's two stages); default 0.5.
+    /// previous frame, and start none (ByteTrack's two stages); default 0.9 (chosen among
+    /// 0.5, 0.7 and 0.9 on the public ACF detections, whose scores lie in 0.5-1, median
+    /// 0.93-0.99: set it for your detector's scale — about its 25th percentile).
     pub high_score: f64,
     /// Least IoU of the second stage's pairs; default 0.5 (ByteTrack's).
     pub low_match_iou: f64,
@@ -102,8 +106,8 @@ pub struct DetectionLikelihoodParams {
     pub min_hits: u32,
     /// Frames a confirmed tracker is kept without a detection, unreported, its particles
     /// coasting on their models, before it ends; a detection on its predicted box in that
-    /// time takes it back, identity and all; default 30 (ByteTrack's buffer; chosen among 1,
-    /// 5 and 30).
+    /// time takes it back, identity and all; default 5 (chosen among 1, 5 and 30; 30, ByteTrack's
+    /// buffer, by two folds of nine).
     pub lost_frames: u32,
     /// Share of a matched tracker's particles drawn around its detection's foot point (σ
     /// as the likelihood's) before weighting, so that a detection the prediction missed by
@@ -143,10 +147,10 @@ impl Default for DetectionLikelihoodParams {
     fn default() -> Self {
         Self {
             match_iou: 0.3,
-            high_score: 0.5,
+            high_score: 0.9,
             low_match_iou: 0.5,
             min_hits: 5,
-            lost_frames: 30,
+            lost_frames: 5,
             proposal_share: 0.5,
             velocity_proposal: true,
             velocity_smoothing: 0.2,
