@@ -145,7 +145,7 @@ fn detections_alone_are_tracked_and_benched() {
     assert_eq!(labels, ["CV", "CV_CA", "SORT", "ByteTrack"]);
     for row in rows {
         let mota = row["median"]["mota"].as_f64().unwrap();
-        // Measured (2026-11-28): 45-46 % MOTA for the IMM-PF (5 seeds), 48.7 % SORT,
+        // Measured (2026-11-28): 44-46 % MOTA for the IMM-PF (5 seeds), 48.7 % SORT,
         // 40.3 % ByteTrack with the public ACF detections of frames 1-150, whose own MODA
         // is 41 %; a tracker that lost the detections falls below 0.
         assert!(mota > 10.0, "{row}");
