@@ -40,13 +40,7 @@ impl PedestrianTracker {
         let unmatched = self.match_in_two_stages(candidates);
         self.correct_on_detections(frame);
         self.end_lost_trackers();
-        let strong = self.params.detection.high_score;
-        let newborn = unmatched
-            .into_iter()
-            .map(|d| candidates[d])
-            .filter(|c| c.score >= strong)
-            .collect::<Vec<_>>();
-        for candidate in newborn {
+        for candidate in unmatched.into_iter().map(|d| candidates[d]) {
             self.next_id += 1;
             let mut track = self.spawn(self.next_id - 1, &candidate.bbox, None, 0);
             track.matched = Some(candidate.bbox);
@@ -57,10 +51,10 @@ impl PedestrianTracker {
         self.report_on_detections(frame, out);
     }
 
-    /// Assigns `candidates` to the trackers (`Track::matched`) and returns the indices of the
-    /// candidates left: first those of score ≥ `high_score` to every tracker (IoU ≥
-    /// `match_iou`), then the others to the trackers still free that a detection held in the
-    /// previous frame (IoU ≥ `low_match_iou`).
+    /// Assigns `candidates` to the trackers (`Track::matched`): first those of score ≥
+    /// `high_score` to every tracker (IoU ≥ `match_iou`), then the others to the trackers
+    /// still free that a detection held in the previous frame (IoU ≥ `low_match_iou`).
+    /// Returns the indices of the confident candidates left, the births.
     fn match_in_two_stages(&mut self, candidates: &[Candidate]) -> Vec<usize> {
         let params = &self.params.detection;
         let predicted: Vec<BoundingBox> = self
