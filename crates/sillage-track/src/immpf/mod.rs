@@ -4,8 +4,9 @@
 //! through resampling ([`sillage_filter::ImmParticleFilter`]).
 //!
 //! - [`PedestrianTracker`]: births on motion blobs or detections no tracker explains, the
-//!   colour and motion likelihood of §4.3 ([`Appearance`]) or, without images, a detection
-//!   likelihood, death when the mean particle likelihood stays low (§5.3);
+//!   colour and motion likelihood of §4.3 ([`Appearance`]), death when the mean particle
+//!   likelihood stays low (§5.3); without images, detections assigned to the predicted boxes
+//!   in two stages, a detection likelihood and SORT's and ByteTrack's life cycle;
 //! - [`BoxSizing`]: box sizes from a ground-plane homography and an adult's size (§4);
 //! - [`PedestrianParams`]: every parameter with the paper's defaults.
 

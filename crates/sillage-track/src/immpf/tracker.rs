@@ -1,7 +1,9 @@
 //! The multi-pedestrian tracker of the IMM-PF paper: one IMM particle filter per person
-//! (§4), born on motion blobs or detections that no tracker explains, scored by colour and
-//! motion histograms (§4.3) or, without images, by the detections, and removed when the mean
-//! likelihood of its particles stays low for some frames (§5.3).
+//! (§4). On frames, born on motion blobs or detections that no tracker explains, scored by
+//! colour and motion histograms (§4.3), and removed when the mean likelihood of its
+//! particles stays low for some frames (§5.3); without frames, the detections are assigned
+//! to the filters' predicted boxes and weigh them, with SORT's and ByteTrack's life cycle
+//! (`on_detections`).
 
 mod on_detections;
 

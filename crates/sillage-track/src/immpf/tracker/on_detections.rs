@@ -5,7 +5,8 @@
 //! to every tracker, then the weak ones to the trackers that a detection held in the previous
 //! frame (ByteTrack's idea: a partly occluded person scores low) — and a tracker's life
 //! follows SORT and ByteTrack: confirmed after `min_hits` matches in a row (its earlier frames
-//! then reported at once), a tentative tracker ends at its first miss, a confirmed one is kept
+//! then reported too, with `report_first_hits`), only confident detections start trackers, a
+//! tentative tracker ends at its first miss, a confirmed one is kept
 //! `lost_frames` frames without a detection and may take one back, and a tracker is reported
 //! on the frames a detection holds it.
 
@@ -114,11 +115,11 @@ impl PedestrianTracker {
         )
     }
 
-    /// Weighs every tracker's particles: a Gaussian of the foot-point distance to its
-    /// detection (σ = `foot_sigma_fraction` × the detection's height) after a share
-    /// `proposal_share` of them was drawn around that foot point ([`propose_on_detection`]);
-    /// a constant without one (the prediction stands). Counts matches in a row and frames without one, and lets
-    /// the box size follow the detections.
+    /// Weighs and resamples the particles of every tracker a detection holds: a Gaussian of
+    /// the foot-point distance (σ = `foot_sigma_fraction` × the detection's height) after a
+    /// share `proposal_share` of them was drawn around that foot point
+    /// ([`propose_on_detection`]); the others coast on their prediction. Counts matches in a
+    /// row and frames without one, and lets the box size follow the detections.
     fn correct_on_detections(&mut self, frame: FrameIndex) {
         let (params, sizing) = (&self.params.detection, &self.sizing);
         self.tracks.par_iter_mut().for_each(|track| {
