@@ -13,7 +13,7 @@ use serde::Serialize;
 use sillage::bedload::fit::fit_bedload_files;
 use sillage::filter::fit::STATE_NAMES;
 use sillage::filter::{BedloadFit, BedloadParams, FitOptions, FitReport};
-use sillage::track::bedload::{EmissionParams, EmissionReport};
+use sillage::track::bedload::{EmissionParams, EmissionReport, SmootherParams};
 
 use crate::shared_args::JsonArg;
 
@@ -42,6 +42,10 @@ pub struct FitBedloadArgs {
     /// Fewest samples for a state's row or noises to be fitted; below, the default is kept.
     #[arg(long, value_name = "N", default_value_t = FitOptions::default().min_samples)]
     pub min_samples: u64,
+    /// With `--tracks`: points on each side over which the evidence is averaged
+    /// (`smoother.half_window`, written beside the model; track with the same).
+    #[arg(long, value_name = "N", default_value_t = SmootherParams::default().half_window)]
+    pub half_window: u32,
     /// `--json`: a machine-readable summary on stdout.
     #[command(flatten)]
     pub json: JsonArg,
@@ -74,18 +78,23 @@ pub fn run_bedload(args: &FitBedloadArgs) -> Result<()> {
     options
         .validate()
         .context("invalid option (--train-fraction, --min-probability, --min-samples)")?;
-    let fitted =
-        fit_bedload_files(&args.truth, args.tracks.as_deref(), &options).with_context(|| {
-            format!(
-                "cannot fit the bedload parameters to --truth {} (a BeadTracking CSV: \
+    let fitted = fit_bedload_files(
+        &args.truth,
+        args.tracks.as_deref(),
+        &options,
+        args.half_window,
+    )
+    .with_context(|| {
+        format!(
+            "cannot fit the bedload parameters to --truth {} (a BeadTracking CSV: \
                  frame,id,x,y,category,vx,vy,motion_state){}",
-                args.truth.display(),
-                args.tracks
-                    .as_ref()
-                    .map(|t| format!(" and --tracks {}", t.display()))
-                    .unwrap_or_default()
-            )
-        })?;
+            args.truth.display(),
+            args.tracks
+                .as_ref()
+                .map(|t| format!(" and --tracks {}", t.display()))
+                .unwrap_or_default()
+        )
+    })?;
     let (fit, text) = (&fitted.fit, &fitted.text);
     let emission = args.tracks.as_deref().zip(fitted.emission.as_ref());
     write_config(&args.out, text)?;
@@ -106,7 +115,10 @@ pub fn run_bedload(args: &FitBedloadArgs) -> Result<()> {
     } else {
         print!("{}", human_summary(args, fit, fitted.tracks));
         if let Some((path, (model, report))) = emission {
-            print!("{}", emission_summary(path, model, report));
+            print!(
+                "{}",
+                emission_summary(path, model, report, args.half_window)
+            );
         }
     }
     Ok(())
@@ -167,10 +179,15 @@ fn human_summary(args: &FitBedloadArgs, fit: &BedloadFit, tracks: usize) -> Stri
 }
 
 /// The smoother's evidence model, one line per state.
-fn emission_summary(path: &Path, model: &EmissionParams, report: &EmissionReport) -> String {
+fn emission_summary(
+    path: &Path,
+    model: &EmissionParams,
+    report: &EmissionReport,
+    half_window: u32,
+) -> String {
     let mut s = format!(
-        "motion-state evidence from {} ({} points unpaired): ln(speed + {:.4} m/s) and \
-         ln(contact ratio), mean ± sd\n",
+        "motion-state evidence from {} ({} points unpaired), over ±{half_window} frames: \
+         ln(mean velocity's speed + {:.4} m/s) and ln(mean contact ratio), mean ± sd\n",
         path.display(),
         report.unpaired,
         model.speed_floor_m_per_s

@@ -56,23 +56,26 @@ fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
     }
 }
 
-/// `track bedload` on the real frames; `lag` is `smoother.lag`.
-fn track_real_beads(dir: &Path, lag: u32) -> std::path::PathBuf {
+/// `track bedload` on the real frames with the `smoother` keys `sets` (`key=value`), into
+/// `dir/name`.
+fn track_real_beads(dir: &Path, name: &str, sets: &[&str]) -> std::path::PathBuf {
     let data = format!("{SHARED}/bedload_beads_lafaye2018");
-    let out = dir.join(format!("tracks_lag{lag}.csv"));
-    run_ok(&[
-        "track",
-        "bedload",
-        &format!("{data}/images"),
-        "--sequence-params",
-        &format!("{data}/sequence_param.txt"),
-        "--mask",
-        &format!("{data}/sequence_base_mask.tif"),
-        "--set",
-        &format!("smoother.lag={lag}"),
-        "--out",
-        path_str(&out),
-    ]);
+    let out = dir.join(name);
+    let mut args = vec![
+        "track".to_string(),
+        "bedload".into(),
+        format!("{data}/images"),
+        "--sequence-params".into(),
+        format!("{data}/sequence_param.txt"),
+        "--mask".into(),
+        format!("{data}/sequence_base_mask.tif"),
+        "--out".into(),
+        path_str(&out).into(),
+    ];
+    for set in sets {
+        args.extend(["--set".into(), format!("smoother.{set}")]);
+    }
+    run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     out
 }
 
@@ -80,15 +83,41 @@ fn track_real_beads(dir: &Path, lag: u32) -> std::path::PathBuf {
 fn bedload_rows_of_the_real_frames_are_unchanged() {
     let dir = tempfile::tempdir().unwrap();
     // A lag of 0 is the frame-by-frame states of before the smoother, row for row.
-    let out = track_real_beads(dir.path(), 0);
+    let out = track_real_beads(dir.path(), "lag0.csv", &["lag=0"]);
     assert_rows(
         &out,
         0xe7a3_6120_a755_ec05,
         "track bedload, smoother.lag = 0",
     );
-    // The default (smoothed states, lag 4), pinned when the smoother was added.
-    let out = track_real_beads(dir.path(), 4);
-    assert_rows(&out, 0x0bf4_7e17_edd5_ac6f, "track bedload");
+    // One frame's evidence, all three states smoothed, with the evidence model of before the
+    // window: the rows pinned when the smoother was added (lag 4).
+    let out = track_real_beads(
+        dir.path(),
+        "one_frame.csv",
+        &[
+            "half_window=0",
+            "saltation_by_frame=false",
+            "emission.resting.log_speed.mean=-6.244",
+            "emission.resting.log_speed.sd=0.611",
+            "emission.resting.log_contact.sd=0.108",
+            "emission.rolling.log_speed.mean=-4.383",
+            "emission.rolling.log_speed.sd=1.600",
+            "emission.rolling.log_contact.mean=-0.101",
+            "emission.rolling.log_contact.sd=0.098",
+            "emission.saltating.log_speed.mean=-1.155",
+            "emission.saltating.log_speed.sd=0.307",
+            "emission.saltating.log_contact.mean=0.149",
+            "emission.saltating.log_contact.sd=0.154",
+        ],
+    );
+    assert_rows(
+        &out,
+        0x0bf4_7e17_edd5_ac6f,
+        "track bedload, smoother.half_window = 0",
+    );
+    // The default (evidence averaged over ±2 frames, saltating by Eq. (4), lag 4).
+    let out = track_real_beads(dir.path(), "default.csv", &[]);
+    assert_rows(&out, 0x294e_4007_cb57_e91e, "track bedload");
 }
 
 /// The ground plane of PETS 2009 S2.L1, fitted from its truth.

@@ -18,6 +18,7 @@ use sillage::pedestrian::immpf::Scene;
 use sillage::pedestrian::motion_prior::{fit_motion_prior, write_motion_prior};
 use sillage::pedestrian::{GroundPlaneFile, ImmpfSettings, SiftPfSettings};
 use sillage::toml_config::load;
+use sillage::track::bedload::SmootherParams;
 use sillage::track::immpf::ModelName;
 use sillage::track::siftpf::FeatureSelection;
 
@@ -61,7 +62,12 @@ pub fn fit(
 /// The MMPF+ motion parameters of a BeadTracking truth with motion states, and the smoother's
 /// evidence with `tracks`.
 fn fit_bedload_file(truth: &Path, tracks: Option<&Path>, out: Option<&Path>) -> Result<String> {
-    let fitted = fit_bedload_files(truth, tracks, &FitOptions::default())?;
+    let fitted = fit_bedload_files(
+        truth,
+        tracks,
+        &FitOptions::default(),
+        SmootherParams::default().half_window,
+    )?;
     if let Some(path) = out {
         write_text(path, &fitted.text)?;
     }

@@ -150,7 +150,7 @@ fn smoothed_states_beat_frame_by_frame_states_on_the_unseen_half() {
             train,
             &radii,
             &params.calibration,
-            &params.smoother.emission,
+            &params.smoother,
             30,
         )
         .unwrap();
@@ -178,5 +178,7 @@ fn smoothed_states_beat_frame_by_frame_states_on_the_unseen_half() {
         assert!(fa[1] >= fb[1] + 0.08, "rolling {fb:?} -> {fa:?}");
         assert!(fa[0] >= fb[0], "resting {fb:?} -> {fa:?}");
         assert!(fa[1] >= 0.65, "rolling {fa:?}");
+        // Saltating is Eq. (4)'s, frame by frame (`saltation_by_frame`).
+        assert_eq!(fa[2], fb[2], "saltating {fb:?} -> {fa:?}");
     }
 }

@@ -34,7 +34,8 @@
 //!     };
 //!     tracker.step(&FrameObservations::from_detections(frame, &detections), &mut points)?;
 //! }
-//! // The states are smoothed over `smoother.lag` frames: the last points come at the end.
+//! // The states are smoothed (`smoother.lag` + `smoother.half_window` frames of delay): the
+//! // last points come at the end.
 //! tracker.finish(&mut points)?;
 //! // One trajectory through the two missed frames, its positions estimated there.
 //! assert_eq!(points.len(), 6);

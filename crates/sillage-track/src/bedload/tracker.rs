@@ -17,7 +17,7 @@ use crate::bedload::params::{
     BedloadTrackerKind, BedloadTrackerParams, ObservedVelocity, Prediction, Settings,
 };
 use crate::bedload::particle::{ParticleMotion, Weighting};
-use crate::bedload::smoother::{CONTACT_RATIO_CAP, Evidence, Smoother, StateChain};
+use crate::bedload::smoother::{CONTACT_RATIO_CAP, Cues, Evidence, Smoother, StateChain};
 
 /// Counts over a run, for reports and tests.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -69,9 +69,9 @@ struct Track {
 ///
 /// Each frame's points are emitted at that frame's step; a tracker's first point is emitted
 /// when a second detection confirms it, so a batch may also hold points of the previous frame.
-/// With a smoother (`smoother.lag` > 0) a point is emitted `lag` frames later, when its state
-/// is final, and the rest at the end of its trajectory or at [`Tracker::finish`]. The output
-/// is identical for any number of threads.
+/// With a smoother (`smoother.lag` > 0) a point is emitted `lag + half_window` frames later,
+/// when its state is final, and the rest at the end of its trajectory or at
+/// [`Tracker::finish`]. The output is identical for any number of threads.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BedloadTracker {
     settings: Settings,
@@ -333,16 +333,18 @@ impl BedloadTracker {
             );
             let speed = track.vel_px_per_frame.map_or(0.0, Vec2::norm);
             track.state = rule.state(n, speed);
-            let evidence = smoother.map(|s| {
-                let ratio = self.contacts.nearest_ratio(
-                    track.pos_px,
-                    track.class,
-                    Some(live),
-                    radii,
-                    CONTACT_RATIO_CAP,
-                );
-                s.evidence(speed, ratio)
-            });
+            let evidence = smoother
+                .and(track.vel_px_per_frame)
+                .map(|vel_px_per_frame| Cues {
+                    vel_px_per_frame,
+                    contact_ratio: self.contacts.nearest_ratio(
+                        track.pos_px,
+                        track.class,
+                        Some(live),
+                        radii,
+                        CONTACT_RATIO_CAP,
+                    ),
+                });
             let mut out = Emit {
                 smoother,
                 chain: &mut track.chain,

@@ -25,14 +25,16 @@ struct ConfigFile<'a> {
     smoother: Option<SmootherSection<'a>>,
 }
 
-/// `[smoother]` with only its evidence model (the lag keeps its default).
+/// `[smoother]` with its evidence model and the window it was learnt over (the lag keeps its
+/// default).
 #[derive(Serialize)]
 struct SmootherSection<'a> {
+    half_window: u32,
     emission: &'a EmissionParams,
 }
 
 /// The points of a BeadTracking CSV (a truth or `sillage track bedload`'s output) as the
-/// smoother's fit reads them: the speed is the file's `vx, vy`.
+/// smoother's fit reads them: the velocity is the file's `vx, vy`.
 pub fn read_labelled_points(path: &Path) -> Result<Vec<LabelledPoint>> {
     Ok(read_bead_csv(path)?
         .iter()
@@ -58,7 +60,7 @@ pub fn fit_smoother(
         frames,
         &params.radius_px,
         &params.calibration,
-        &params.smoother.emission,
+        &params.smoother,
         min_samples,
     )
     .map_err(|e| Error::input(format!("{}: {e}", truth.display())))
@@ -126,12 +128,16 @@ pub struct BedloadFitFile {
 
 /// Learns the motion parameters from `truth` (a BeadTracking CSV with states) and, with
 /// `tracks` (`sillage track bedload`'s output on the same frames), the smoother's evidence
-/// model on the same training frames; errors name the file.
+/// model on the same training frames, its features averaged over `half_window`
+/// (`smoother.half_window`, written beside the model); errors name the file.
 pub fn fit_bedload_files(
     truth: &Path,
     tracks: Option<&Path>,
     options: &FitOptions,
+    half_window: u32,
 ) -> Result<BedloadFitFile> {
+    let mut params = BedloadTrackerParams::default();
+    params.smoother.half_window = half_window;
     let truth_tracks = read_state_tracks(truth)?;
     let without = tracks_without_state(&truth_tracks);
     let fit = fit_bedload(&truth_tracks, &BedloadParams::default(), options)
@@ -142,7 +148,7 @@ pub fn fit_bedload_files(
                 truth,
                 path,
                 fit.report.training_frames,
-                &BedloadTrackerParams::default(),
+                &params,
                 options.min_samples,
             )
         })
@@ -153,7 +159,9 @@ pub fn fit_bedload_files(
         &fit,
         truth_tracks.len(),
         without,
-        tracks.zip(emission.as_ref()).map(|(p, (m, r))| (p, m, r)),
+        tracks
+            .zip(emission.as_ref())
+            .map(|(p, (m, r))| (p, half_window, m, r)),
     )?;
     Ok(BedloadFitFile {
         fit,
@@ -172,7 +180,7 @@ fn config_text(
     fit: &BedloadFit,
     tracks: usize,
     tracks_without_state: usize,
-    emission: Option<(&Path, &EmissionParams, &EmissionReport)>,
+    emission: Option<(&Path, u32, &EmissionParams, &EmissionReport)>,
 ) -> Result<String> {
     let r = &fit.report;
     let mut text = String::new();
@@ -227,10 +235,10 @@ fn config_text(
          keys are the defaults: set flow_vel_px_per_frame for your sequence"
             .into(),
     );
-    if let Some((tracks_file, _, report)) = emission {
+    if let Some((tracks_file, half_window, _, report)) = emission {
         line(format!(
             "[smoother.emission] from the tracker's points of {} paired with the truth in the \
-             training frames: {} ({} unpaired)",
+             training frames, averaged over ±{half_window} frames: {} ({} unpaired)",
             tracks_file.display(),
             per_state(|s| report.samples[s].to_string()),
             report.unpaired
@@ -238,7 +246,10 @@ fn config_text(
     }
     let body = toml::to_string(&ConfigFile {
         motion: &fit.params,
-        smoother: emission.map(|(_, emission, _)| SmootherSection { emission }),
+        smoother: emission.map(|(_, half_window, emission, _)| SmootherSection {
+            half_window,
+            emission,
+        }),
     })
     .map_err(|e| Error::input(format!("cannot write the fitted parameters as TOML: {e}")))?;
     Ok(format!("{text}\n{body}"))
