@@ -479,6 +479,10 @@ mod tests {
         params.smoother.lag = crate::bedload::smoother::MAX_LAG + 1;
         let e = params.validate().unwrap_err().to_string();
         assert!(e.contains("`smoother.lag`"), "{e}");
+        let mut params = BedloadTrackerParams::default();
+        params.smoother.half_window = crate::bedload::smoother::MAX_LAG + 1;
+        let e = params.validate().unwrap_err().to_string();
+        assert!(e.contains("`smoother.half_window`"), "{e}");
         assert!(
             BedloadTrackerParams::default()
                 .settings()

@@ -227,23 +227,17 @@ impl SmootherParams {
         transition: &[[f64; 3]; 3],
         calibration: &Calibration,
     ) -> Result<Option<Smoother>> {
-        if self.half_window > MAX_LAG {
-            return Err(Error::parameter(
-                "smoother.half_window",
-                self.half_window,
-                format!(
-                    "must be at most {MAX_LAG} frames (a few frames suffice; 0 averages nothing)"
-                ),
-            ));
-        }
-        if self.lag > MAX_LAG {
-            return Err(Error::parameter(
-                "smoother.lag",
-                self.lag,
-                format!(
-                    "must be at most {MAX_LAG} frames (a few frames suffice; 0 turns smoothing off)"
-                ),
-            ));
+        for (key, frames, zero) in [
+            ("smoother.half_window", self.half_window, "averages nothing"),
+            ("smoother.lag", self.lag, "turns smoothing off"),
+        ] {
+            if frames > MAX_LAG {
+                return Err(Error::parameter(
+                    key,
+                    frames,
+                    format!("must be at most {MAX_LAG} frames (a few frames suffice; 0 {zero})"),
+                ));
+            }
         }
         let e = &self.emission;
         if !(e.speed_floor_m_per_s.is_finite() && e.speed_floor_m_per_s > 0.0) {
