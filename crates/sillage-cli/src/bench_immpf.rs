@@ -5,7 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use sillage::experiments::immpf::{BenchInput, BenchProgress, Row, bench};
+use sillage::experiments::held_out::{
+    GridAxis, HeldOutProgress, HeldOutRow, Split, bench_held_out, criterion,
+};
+use sillage::experiments::immpf::{BenchInput, BenchProgress, Row, RunScores, bench};
 use sillage::pedestrian::ImmpfSettings;
 use sillage::pedestrian::immpf::Scene;
 use sillage::track::immpf::ModelName;
@@ -53,6 +56,16 @@ pub struct BenchImmpfArgs {
     /// Use the first N frames of each sequence.
     #[arg(long, value_name = "N")]
     pub max_frames: Option<usize>,
+    /// Settings chosen on other sequences than the one reported: every combination of the
+    /// grid's values is benched, and each sequence is reported with the combination of best
+    /// mean (MOTA + IDF1) / 2 on the others (repeatable; e.g. `--grid
+    /// tracker.detection.min_hits=3,4,5`).
+    #[arg(long, value_name = "KEY=V1,V2")]
+    pub grid: Vec<String>,
+    /// With `--grid`: choose once on these sequences (folder names, comma-separated) and
+    /// report on the others, instead of leaving each sequence out in turn.
+    #[arg(long, value_delimiter = ',', value_name = "NAME")]
+    pub tune_on: Vec<String>,
     /// `--json`: a machine-readable summary on stdout.
     #[command(flatten)]
     pub json: JsonArg,
@@ -73,6 +86,9 @@ pub fn run(args: &BenchImmpfArgs) -> Result<()> {
         births_from_detections: args.births_from_detections,
         max_frames: args.max_frames,
     };
+    if !args.grid.is_empty() || !args.tune_on.is_empty() {
+        return run_held_out(args, input, &scene, &combinations);
+    }
     let rows = bench(
         &args.sequences,
         input,
@@ -124,5 +140,89 @@ fn markdown(rows: &[Row]) -> String {
         text.push('\n');
         text.push_str(&format_row(row));
     }
+    text
+}
+
+/// `--grid` / `--tune-on`: settings chosen on some sequences, reported on the others.
+fn run_held_out(
+    args: &BenchImmpfArgs,
+    input: BenchInput,
+    scene: &Scene,
+    combinations: &[Vec<ModelName>],
+) -> Result<()> {
+    let axes = args
+        .grid
+        .iter()
+        .map(|g| GridAxis::parse(g))
+        .collect::<sillage::core::Result<Vec<_>>>()?;
+    let split = if args.tune_on.is_empty() {
+        Split::LeaveOneOut
+    } else {
+        Split::TuneOn(args.tune_on.clone())
+    };
+    let rows = bench_held_out(
+        &args.sequences,
+        input,
+        args.params.config.as_deref(),
+        &args.params.overrides,
+        &axes,
+        &split,
+        scene,
+        combinations,
+        args.runs,
+        &mut |progress| match progress {
+            HeldOutProgress::Combination {
+                index,
+                total,
+                overrides,
+            } => eprintln!("combination {}/{total}: {}", index + 1, overrides.join(" ")),
+            HeldOutProgress::Bench(BenchProgress::Row(row)) => eprintln!("{}", format_row(row)),
+            HeldOutProgress::Bench(BenchProgress::Prepared { .. }) => {}
+        },
+    )?;
+    if args.json.enabled {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        println!("{}", held_out_markdown(&rows));
+    }
+    Ok(())
+}
+
+/// `MOTA / IDF1` of a baseline, or a dash.
+fn mota_idf1(scores: Option<&RunScores>) -> String {
+    scores.map_or("–".into(), |s| format!("{:.1} / {:.1}", s.mota, s.idf1))
+}
+
+fn held_out_markdown(rows: &[HeldOutRow]) -> String {
+    let mut text = String::from(
+        "| reported | chosen on | chosen | tuning (MOTA+IDF1)/2 | MOTA / IDF1 | SORT | ByteTrack |\n\
+         |---|---|---|---:|---|---|---|",
+    );
+    for r in rows {
+        text.push_str(&format!(
+            "\n| {} | {} | {} | {:.1} | {} | {} | {} |",
+            r.sequence,
+            r.tuned_on.join(", "),
+            r.chosen.join(" "),
+            r.tuning_score,
+            mota_idf1(Some(&r.held_out)),
+            mota_idf1(r.sort.as_ref()),
+            mota_idf1(r.bytetrack.as_ref()),
+        ));
+    }
+    let mean = |f: &dyn Fn(&HeldOutRow) -> Option<f64>| -> String {
+        let values: Vec<f64> = rows.iter().filter_map(f).collect();
+        if values.len() == rows.len() && !values.is_empty() {
+            format!("{:.1}", values.iter().sum::<f64>() / values.len() as f64)
+        } else {
+            "–".into()
+        }
+    };
+    text.push_str(&format!(
+        "\n| **mean (MOTA+IDF1)/2** | | | | {} | {} | {} |",
+        mean(&|r| Some(criterion(&r.held_out))),
+        mean(&|r| r.sort.as_ref().map(criterion)),
+        mean(&|r| r.bytetrack.as_ref().map(criterion)),
+    ));
     text
 }

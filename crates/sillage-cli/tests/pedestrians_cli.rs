@@ -152,6 +152,97 @@ fn detections_alone_are_tracked_and_benched() {
     }
 }
 
+const TUD: [&str; 2] = [
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/mot15_train_gt_det/TUD-Campus"
+    ),
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/mot15_train_gt_det/TUD-Stadtmitte"
+    ),
+];
+
+/// `bench immpf --detections-only --models CV_CA --runs 1` on `sequences` with `extra`
+/// options, as JSON.
+fn bench_detections(sequences: &[&str], extra: &[&str]) -> serde_json::Value {
+    let mut args = vec![
+        "bench",
+        "immpf",
+        "--detections-only",
+        "--models",
+        "CV_CA",
+        "--runs",
+        "1",
+        "--json",
+    ];
+    args.extend(sequences);
+    args.extend(extra);
+    serde_json::from_str(&run_ok(&args)).unwrap()
+}
+
+#[test]
+fn settings_are_chosen_on_the_other_sequences_and_reported_on_the_one_left_out() {
+    let sequences = [TUD[0], TUD[1], PETS];
+    let grid = ["--grid", "tracker.detection.min_hits=3,5"];
+    let rows = bench_detections(&sequences, &grid);
+    let rows = rows.as_array().unwrap();
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["sequence"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["TUD-Campus", "TUD-Stadtmitte", "pets09_s2l1"]);
+    for (row, folder) in rows.iter().zip(sequences) {
+        let name = row["sequence"].as_str().unwrap();
+        let tuned_on: Vec<&str> = row["tuned_on"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap())
+            .collect();
+        assert_eq!(tuned_on.len(), 2);
+        assert!(!tuned_on.contains(&name), "{row}");
+        // The reported scores are the chosen setting's own on the held-out sequence.
+        let chosen = row["chosen"][0].as_str().unwrap();
+        assert!(
+            chosen.starts_with("tracker.detection.min_hits="),
+            "{chosen}"
+        );
+        let alone = bench_detections(&[folder], &["--set", chosen]);
+        assert_eq!(alone[0]["median"]["mota"], row["held_out"]["mota"], "{row}");
+        assert_eq!(
+            alone[2]["median"]["idf1"], row["bytetrack"]["idf1"],
+            "{row}"
+        );
+    }
+    // One choice on PETS, reported on the two TUD sequences.
+    let tuned = bench_detections(&sequences, &[grid[0], grid[1], "--tune-on", "pets09_s2l1"]);
+    let tuned = tuned.as_array().unwrap();
+    assert_eq!(tuned.len(), 2);
+    assert!(
+        tuned
+            .iter()
+            .all(|r| r["tuned_on"] == serde_json::json!(["pets09_s2l1"]))
+    );
+    // A sequence not benched, a malformed grid, two model combinations.
+    let mut args = vec!["bench", "immpf", "--detections-only", "--runs", "1"];
+    args.extend(sequences);
+    let message =
+        run_user_error(&[&args[..], &["--models", "CV_CA", "--tune-on", "KITTI-13"]].concat());
+    assert!(message.contains("--tune-on KITTI-13"), "{message}");
+    let message = run_user_error(
+        &[
+            &args[..],
+            &["--models", "CV_CA", "--grid", "tracker.detection.min_hits"],
+        ]
+        .concat(),
+    );
+    assert!(message.contains("KEY=V1,V2"), "{message}");
+    let message =
+        run_user_error(&[&args[..], &["--models", "CV,CV_CA", "--grid", grid[1]]].concat());
+    assert!(message.contains("one model combination"), "{message}");
+}
+
 #[test]
 fn bad_inputs_are_refused_with_the_file_named() {
     let dir = tempfile::tempdir().unwrap();

@@ -81,7 +81,7 @@ impl ModelName {
 /// `high_score`, `min_hits`, `lost_frames`, `report_first_hits`, `velocity_proposal` and
 /// `size_smoothing` were chosen together leave-one-sequence-out on the nine shared detection
 /// sequences (the eight MOT15 training sequences and PETS09-S2L1 frames 1-150, public ACF
-/// detections; `tools/immpf_loso.py`, docs/immpf.md): each sequence held out in turn, the
+/// detections; `sillage bench immpf --grid`, docs/immpf.md): each sequence held out in turn, the
 /// best of 216 combinations on the other eight, scored on the held-out one, gave a mean
 /// (MOTA + IDF1) / 2 of 55.0 % (SORT 52.0, ByteTrack 49.5, this mode before 41.5); the
 /// defaults are the combination seven folds chose (the other two differ in `lost_frames`

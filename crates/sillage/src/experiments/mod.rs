@@ -2,6 +2,7 @@
 //! median over seeded runs.
 
 pub mod bedload;
+pub mod held_out;
 pub mod immpf;
 pub mod sequences;
 pub mod siftpf;
