@@ -29,7 +29,8 @@ pub const IMMPF_COMBINATIONS: [&str; 7] = [
 /// `sillage bench immpf`.
 #[derive(Debug, Args)]
 pub struct BenchImmpfArgs {
-    /// MOTChallenge sequence folders (`img1/`, `det/det.txt`, `gt/gt.txt`, `seqinfo.ini`).
+    /// MOTChallenge sequence folders (`img1/` or one `video/*.mp4`, `det/det.txt`, `gt/gt.txt`,
+    /// `seqinfo.ini`).
     #[arg(required = true)]
     pub sequences: Vec<PathBuf>,
     /// Model combinations, comma-separated (default: the paper's seven).

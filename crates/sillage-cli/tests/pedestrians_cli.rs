@@ -244,6 +244,32 @@ fn settings_are_chosen_on_the_other_sequences_and_reported_on_the_one_left_out()
 }
 
 #[test]
+fn a_sequence_whose_frames_are_a_video_is_benched_from_pixels() {
+    // TUD-Campus has no img1/, only video/TUD-Campus.mp4 (decoded by ffmpeg).
+    let table = run_ok(&[
+        "bench",
+        "immpf",
+        TUD[0],
+        "--models",
+        "CV",
+        "--runs",
+        "1",
+        "--max-frames",
+        "20",
+        "--json",
+    ]);
+    let rows: serde_json::Value = serde_json::from_str(&table).unwrap();
+    let labels: Vec<&str> = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["models"].as_str().unwrap())
+        .collect();
+    assert_eq!(labels, ["CV", "SORT", "ByteTrack"]);
+    assert!(rows[0]["median"]["tracks"].as_f64().unwrap() > 0.0, "{rows}");
+}
+
+#[test]
 fn bad_inputs_are_refused_with_the_file_named() {
     let dir = tempfile::tempdir().unwrap();
     let singular = dir.path().join("singular.toml");

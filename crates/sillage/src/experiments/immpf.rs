@@ -23,7 +23,7 @@ use sillage_track::immpf::{
 use sillage_track::sort::SortParams;
 
 use super::median_over;
-use super::sequences::{SequenceTruth, sequence_name};
+use super::sequences::{SequenceTruth, sequence_frames, sequence_name};
 use crate::pedestrian::boxes::{BoxTracker, track_boxes};
 use crate::pedestrian::immpf::{Scene, step};
 use crate::pedestrian::input::{PedestrianInput, PreparedFrame, frame_size_beside};
@@ -189,8 +189,8 @@ struct Sequence {
 }
 
 impl Sequence {
-    /// Reads and prepares one MOTChallenge sequence folder (`img1/`, `det/det.txt`,
-    /// `gt/gt.txt`, `seqinfo.ini`).
+    /// Reads and prepares one MOTChallenge sequence folder (`img1/` or one `video/*.mp4`,
+    /// `det/det.txt`, `gt/gt.txt`, `seqinfo.ini`).
     fn prepare(
         folder: &Path,
         input: BenchInput,
@@ -198,18 +198,18 @@ impl Sequence {
         params: &PedestrianParams,
     ) -> Result<Self> {
         let detections = folder.join("det").join("det.txt");
-        let images = folder.join("img1");
         let use_images = !input.detections_only;
-        if use_images && !images.is_dir() {
-            return Err(Error::input(format!(
-                "{} has no img1/ folder of frames; add --detections-only to track its \
-                 det/det.txt",
-                folder.display()
-            )));
-        }
-        let images = images.to_string_lossy().into_owned();
+        let images = if use_images {
+            Some(sequence_frames(folder).map_err(|e| {
+                Error::input(format!(
+                    "{e}; or add --detections-only to track its det/det.txt"
+                ))
+            })?)
+        } else {
+            None
+        };
         let mut source = PedestrianInput::open(
-            use_images.then_some(images.as_str()),
+            images.as_deref(),
             (input.births_from_detections || !use_images).then_some(detections.as_path()),
             frame_size_beside(&detections),
             motion,
