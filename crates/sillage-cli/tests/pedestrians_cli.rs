@@ -266,7 +266,10 @@ fn a_sequence_whose_frames_are_a_video_is_benched_from_pixels() {
         .map(|r| r["models"].as_str().unwrap())
         .collect();
     assert_eq!(labels, ["CV", "SORT", "ByteTrack"]);
-    assert!(rows[0]["median"]["tracks"].as_f64().unwrap() > 0.0, "{rows}");
+    assert!(
+        rows[0]["median"]["tracks"].as_f64().unwrap() > 0.0,
+        "{rows}"
+    );
 }
 
 #[test]
