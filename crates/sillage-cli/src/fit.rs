@@ -66,6 +66,9 @@ struct JsonSummary<'a> {
     /// The smoother's evidence model and its samples, with `--tracks`.
     #[serde(skip_serializing_if = "Option::is_none")]
     emission: Option<(&'a EmissionParams, &'a EmissionReport)>,
+    /// The window the evidence was averaged over, with `--tracks`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    half_window: Option<u32>,
 }
 
 /// `sillage fit bedload --truth FILE --out FILE`.
@@ -110,6 +113,7 @@ pub fn run_bedload(args: &FitBedloadArgs) -> Result<()> {
             motion: &fit.params,
             report: &fit.report,
             emission: fitted.emission.as_ref().map(|(m, r)| (m, r)),
+            half_window: args.tracks.as_ref().map(|_| args.half_window),
         };
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {

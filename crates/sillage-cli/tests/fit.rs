@@ -319,6 +319,27 @@ fn fits_the_smoother_evidence_and_the_tracker_reads_it() {
     // Resting beads barely move, saltating ones fly: the learnt speeds are ordered.
     assert!(e.resting.log_speed.mean < e.rolling.log_speed.mean);
     assert!(e.rolling.log_speed.mean < e.saltating.log_speed.mean);
+    // The window the evidence was learnt over is written beside it; a narrower one averages
+    // a resting bead's jitter less, so its learnt speed is higher.
+    assert_eq!(config.smoother.half_window, 2);
+    let narrow = dir.path().join("fit0.toml");
+    let stdout = fit(
+        TRUTH,
+        &narrow,
+        &[
+            "--tracks",
+            path_str(&tracks),
+            "--half-window",
+            "0",
+            "--json",
+        ],
+    );
+    let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(summary["half_window"], 0);
+    let narrow: sillage::track::bedload::BedloadTrackerParams =
+        toml::from_str(&fs::read_to_string(&narrow).unwrap()).unwrap();
+    assert_eq!(narrow.smoother.half_window, 0);
+    assert!(narrow.smoother.emission.resting.log_speed.mean > e.resting.log_speed.mean);
     let output = track(&["--config", path_str(&out)]);
     assert!(output.status.success(), "{}", stderr(&output));
     // Ten frames cannot hold a lag of ten.
