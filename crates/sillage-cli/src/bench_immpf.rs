@@ -86,6 +86,7 @@ pub fn run(args: &BenchImmpfArgs) -> Result<()> {
         detections_only: args.detections_only,
         births_from_detections: args.births_from_detections,
         max_frames: args.max_frames,
+        skip_baselines: false,
     };
     if !args.grid.is_empty() || !args.tune_on.is_empty() {
         return run_held_out(args, input, &scene, &combinations);

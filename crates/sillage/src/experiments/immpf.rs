@@ -98,6 +98,8 @@ pub struct BenchInput {
     pub births_from_detections: bool,
     /// Use the first N frames of each sequence.
     pub max_frames: Option<usize>,
+    /// Leave out the SORT and ByteTrack rows (already benched on the same sequences).
+    pub skip_baselines: bool,
 }
 
 /// What [`bench`] reports as it goes.
@@ -163,7 +165,7 @@ pub fn bench(
             on_progress(BenchProgress::Row(&row));
             rows.push(row);
         }
-        let baselines = if folder.join("det").join("det.txt").is_file() {
+        let baselines = if !input.skip_baselines && folder.join("det").join("det.txt").is_file() {
             vec![
                 BoxTracker::Sort(SortParams::default()),
                 BoxTracker::ByteTrack(ByteTrackParams::default()),
