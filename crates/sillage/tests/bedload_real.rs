@@ -14,6 +14,9 @@ use sillage::track::bedload::{
     BedloadTrackerKind, BedloadTrackerParams, LabelledPoint, SmootherParams, fit_emission,
 };
 
+mod support;
+use support::in_frames;
+
 const DATA: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../../../shared/data/bedload_beads_lafaye2018"
@@ -110,15 +113,6 @@ fn mmpf_plus_tracks_the_real_frames_as_well_as_the_paper_reports() {
     );
     assert!(mmpf_plus.table1.correct_track_rate >= 0.95);
     assert!(mmpf_plus.table1.id_switches <= 2);
-}
-
-/// The points of frames `range` (0-based, inclusive).
-fn in_frames(points: &[TrackPoint], range: [u64; 2]) -> Vec<TrackPoint> {
-    points
-        .iter()
-        .filter(|p| (range[0]..=range[1]).contains(&p.frame))
-        .copied()
-        .collect()
 }
 
 /// Issue "Bedload motion states you can trust": the smoother's evidence learnt on one half

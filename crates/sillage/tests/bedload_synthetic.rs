@@ -12,6 +12,9 @@ use sillage::track::bedload::{
     BedloadTrackerKind, BedloadTrackerParams, LabelledPoint, fit_emission,
 };
 
+mod support;
+use support::in_frames;
+
 fn sequence() -> (Vec<BedloadSample>, BedloadSceneParams) {
     let scene = BedloadSceneParams {
         n_frames: 60,
@@ -75,15 +78,6 @@ fn table1_on_a_synthetic_sequence() {
     assert!(mmpf_plus.table1.id_switches < det.table1.id_switches);
     assert!(mmpf_plus.table1.correct_tracks > det.table1.correct_tracks);
     assert!(mmpf_plus.mot.identity.idf1 > det.mot.identity.idf1);
-}
-
-/// The points of `points` in frames `range` (inclusive, 0-based).
-fn in_frames(points: &[TrackPoint], range: [u64; 2]) -> Vec<TrackPoint> {
-    points
-        .iter()
-        .filter(|p| (range[0]..=range[1]).contains(&p.frame))
-        .copied()
-        .collect()
 }
 
 /// Issue "Bedload motion states you can trust", its synthetic bar: on a 1,000-frame sequence

@@ -1,5 +1,5 @@
 //! Shared helpers of the facade's integration tests: a synthetic vortex run scored against
-//! its truth.
+//! its truth, and points cut to a frame range.
 
 use std::path::PathBuf;
 
@@ -11,6 +11,7 @@ use sillage::{Pipeline, PipelineConfig, RunSummary};
 
 /// Tracks the vortex sequence of `params` with `config` (frames streamed from the generator)
 /// and returns the emitted points with the truth.
+#[allow(dead_code)] // not every test file runs the vortex
 pub fn track_vortex(
     params: &VortexParams,
     config: &PipelineConfig,
@@ -36,7 +37,18 @@ pub fn track_vortex(
 }
 
 /// The TracTrac paper's accuracy indexes of a vortex run (d = 1 px).
+#[allow(dead_code)] // not every test file runs the vortex
 pub fn vortex_accuracy(params: &VortexParams, config: &PipelineConfig) -> PtvAccuracy {
     let (tracks, truth, _) = track_vortex(params, config);
     ptv_accuracy(&truth, &tracks, &PtvAccuracyParams::default()).expect("finite inputs")
+}
+
+/// The points of `points` in frames `range` (inclusive, 0-based).
+#[allow(dead_code)] // used by the bedload tests only
+pub fn in_frames(points: &[TrackPoint], range: [u64; 2]) -> Vec<TrackPoint> {
+    points
+        .iter()
+        .filter(|p| (range[0]..=range[1]).contains(&p.frame))
+        .copied()
+        .collect()
 }
