@@ -13,7 +13,7 @@ use serde::Serialize;
 use sillage::bedload::fit::fit_bedload_files;
 use sillage::filter::fit::STATE_NAMES;
 use sillage::filter::{BedloadFit, BedloadParams, FitOptions, FitReport};
-use sillage::track::bedload::{EmissionParams, EmissionReport, SmootherParams};
+use sillage::track::bedload::{EmissionParams, EmissionReport, STRETCH_POINTS, SmootherParams};
 
 use crate::shared_args::JsonArg;
 
@@ -211,6 +211,11 @@ fn emission_summary(
             m.log_contact.sd
         );
     }
+    let _ = writeln!(
+        s,
+        "saltating at or above {:.3} m/s over the steadiest stretch of {STRETCH_POINTS} points",
+        model.saltation_speed_m_per_s
+    );
     s
 }
 

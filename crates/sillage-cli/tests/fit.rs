@@ -319,6 +319,15 @@ fn fits_the_smoother_evidence_and_the_tracker_reads_it() {
     // Resting beads barely move, saltating ones fly: the learnt speeds are ordered.
     assert!(e.resting.log_speed.mean < e.rolling.log_speed.mean);
     assert!(e.rolling.log_speed.mean < e.saltating.log_speed.mean);
+    // The saltation threshold is learnt too, between the rolling and the saltating speeds.
+    assert!(stdout.contains("saltating at or above"), "{stdout}");
+    assert!(text.contains("saltation_speed_m_per_s"), "{text}");
+    let threshold = e.saltation_speed_m_per_s.ln();
+    assert!(e.rolling.log_speed.mean < threshold && threshold < e.saltating.log_speed.mean);
+    assert_ne!(
+        e.saltation_speed_m_per_s,
+        sillage::track::bedload::EmissionParams::default().saltation_speed_m_per_s
+    );
     // The window the evidence was learnt over is written beside it; a narrower one averages
     // a resting bead's jitter less, so its learnt speed is higher.
     assert_eq!(config.smoother.half_window, 2);

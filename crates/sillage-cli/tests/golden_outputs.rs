@@ -96,7 +96,7 @@ fn bedload_rows_of_the_real_frames_are_unchanged() {
         "one_frame.csv",
         &[
             "half_window=0",
-            "saltation_by_frame=false",
+            "saltation=smoothed",
             "emission.resting.log_speed.mean=-6.244",
             "emission.resting.log_speed.sd=0.611",
             "emission.resting.log_contact.sd=0.108",
@@ -115,9 +115,16 @@ fn bedload_rows_of_the_real_frames_are_unchanged() {
         0x0bf4_7e17_edd5_ac6f,
         "track bedload, smoother.half_window = 0",
     );
-    // The default (evidence averaged over ±2 frames, saltating by Eq. (4), lag 4).
+    // The default (evidence averaged over ±2 frames, saltating over the steadiest stretch,
+    // lag 4); with Eq. (4)'s saltating instead, the rows of before the steadiest stretch.
+    let out = track_real_beads(dir.path(), "frame_salt.csv", &["saltation=frame"]);
+    assert_rows(
+        &out,
+        0x294e_4007_cb57_e91e,
+        "track bedload, smoother.saltation = frame",
+    );
     let out = track_real_beads(dir.path(), "default.csv", &[]);
-    assert_rows(&out, 0x294e_4007_cb57_e91e, "track bedload");
+    assert_rows(&out, 0xcd45_e4ad_157d_8b0d, "track bedload");
 }
 
 /// The ground plane of PETS 2009 S2.L1, fitted from its truth.

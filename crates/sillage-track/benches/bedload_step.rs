@@ -13,7 +13,9 @@ use std::hint::black_box;
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
 use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker, rng_stream};
-use sillage_track::bedload::{BedloadTracker, BedloadTrackerKind, BedloadTrackerParams};
+use sillage_track::bedload::{
+    BedloadTracker, BedloadTrackerKind, BedloadTrackerParams, SaltationRule,
+};
 
 const WARM_FRAMES: u64 = 10;
 
@@ -136,6 +138,12 @@ fn trackers(c: &mut Criterion) {
             let mut params = BedloadTrackerParams::default();
             params.smoother.lag = 0;
             ("mmpf_plus_lag0".to_string(), params, 400)
+        }))
+        .chain(std::iter::once({
+            // Saltating by Eq. (4) frame by frame, to show the steadiest stretch's cost.
+            let mut params = BedloadTrackerParams::default();
+            params.smoother.saltation = SaltationRule::Frame;
+            ("mmpf_plus_frame_salt".to_string(), params, 400)
         }))
         .collect();
     bench_step(c, "bedload_trackers", &cases);

@@ -59,6 +59,6 @@ pub use params::{
 };
 pub use smoother::{
     CONTACT_RATIO_CAP, EmissionParams, EmissionReport, LabelledPoint, LogGaussian, MAX_LAG,
-    SmootherParams, StateEmission, fit_emission,
+    STRETCH_POINTS, SaltationRule, SmootherParams, StateEmission, fit_emission,
 };
 pub use tracker::{BedloadStats, BedloadTracker};

@@ -483,6 +483,13 @@ mod tests {
         params.smoother.half_window = crate::bedload::smoother::MAX_LAG + 1;
         let e = params.validate().unwrap_err().to_string();
         assert!(e.contains("`smoother.half_window`"), "{e}");
+        let mut params = BedloadTrackerParams::default();
+        params.smoother.emission.saltation_speed_m_per_s = f64::NAN;
+        let e = params.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("`smoother.emission.saltation_speed_m_per_s`"),
+            "{e}"
+        );
         assert!(
             BedloadTrackerParams::default()
                 .settings()
