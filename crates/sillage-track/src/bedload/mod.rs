@@ -59,6 +59,7 @@ pub use params::{
 };
 pub use smoother::{
     CONTACT_RATIO_CAP, EmissionParams, EmissionReport, LabelledPoint, LogGaussian, MAX_LAG,
-    STRETCH_POINTS, SaltationRule, SmootherParams, StateEmission, fit_emission,
+    SALTATION_PLATEAU_F, STRETCH_POINTS, SaltationRule, SmootherParams, StateEmission,
+    fit_emission,
 };
 pub use tracker::{BedloadStats, BedloadTracker};
