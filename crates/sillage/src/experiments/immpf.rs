@@ -117,8 +117,9 @@ pub enum BenchProgress<'a> {
 
 /// Every combination of `combinations` on every sequence folder, each row the medians over
 /// the seeds `1..=runs` (run in parallel), then SORT and ByteTrack on the sequence's
-/// `det/det.txt`, when it has one, over the same frames (rows `SORT`, `ByteTrack`). Without a motion prior in `scene`, MP uses one
-/// learned from the sequence's own CV_CA tracks ([`self_prior`]).
+/// `det/det.txt`, when it has one, over the same frames (rows `SORT`, `ByteTrack`). Without
+/// a motion prior in `scene`, MP uses one learned from the sequence's own CV_CA tracks
+/// ([`self_prior`]).
 pub fn bench(
     folders: &[impl AsRef<Path>],
     input: BenchInput,
