@@ -7,6 +7,7 @@ use clap::Args;
 use serde::Serialize;
 use sillage::io::{SkippedFrame, TrackFormat};
 use sillage::ptv_run::{PtvRun, load_ptv_config};
+use sillage::track::ptv::AUTO_VOTE_MIN_VALID_SHARE;
 use sillage::windows::WindowPlan;
 use sillage::{PipelineConfig, RunSummary, Tracking};
 
@@ -118,9 +119,20 @@ pub fn run(args: &PtvArgs) -> Result<()> {
         let voting = summary.vote_search_px.map_or("off".to_string(), |r| {
             format!("on, search radius {r:.1} px")
         });
+        let resolved = summary.vote_valid_share.map_or(String::new(), |share| {
+            format!(
+                ", {:.0} % of the points in cells the vote resolved{}",
+                100.0 * share,
+                if share < AUTO_VOTE_MIN_VALID_SHARE {
+                    " (too few: the flow varies within a voting cell, so the vote is not used)"
+                } else {
+                    ""
+                }
+            )
+        });
         eprintln!(
-            "displacements measured on the first two frames: 95 % within {displacement:.2} px \
-             → displacement voting {voting}"
+            "displacements measured on the first two frames: 95 % within {displacement:.2} px\
+             {resolved} → displacement voting {voting}"
         );
     }
     if args.json.enabled {

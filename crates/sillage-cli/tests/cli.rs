@@ -328,3 +328,34 @@ fn one_thread_and_the_default_write_the_same_bytes() {
     assert_eq!(one, run(None, "default_track.txt"));
     assert_eq!(run(Some("1"), "one.csv"), run(None, "default.csv"));
 }
+
+#[test]
+fn bench_ptv_accuracy_runs_the_moderate_family() {
+    let output = sillage(&[
+        "bench",
+        "ptv-accuracy",
+        "--family",
+        "moderate",
+        "--half",
+        "tune",
+        "--size",
+        "128",
+        "--frames",
+        "4",
+        "--no-search",
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let rows: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 24);
+    for row in rows {
+        assert_eq!(row["case"]["half"], "tune");
+        assert!(
+            row["case"]["name"].as_str().unwrap().contains("-m"),
+            "{row}"
+        );
+        let true_pct = row["defaults"]["true_pct"].as_f64().unwrap();
+        assert!((0.0..=100.0).contains(&true_pct), "{row}");
+    }
+}

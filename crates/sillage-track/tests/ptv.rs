@@ -4,7 +4,10 @@ use std::collections::HashMap;
 
 use rand::RngExt;
 use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker, Vec2, rng_stream};
-use sillage_track::ptv::{PassDirection, PtvParams, PtvTracker, VoteSearch};
+use sillage_track::ptv::{
+    AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MIN_VALID_SHARE, PassDirection, PtvParams, PtvTracker,
+    VoteSearch,
+};
 
 /// Detections per frame and the true particle id of each detection.
 struct Scene {
@@ -257,6 +260,48 @@ fn displacement_voting_tracks_a_rotation_faster_than_the_spacing_in_one_pass() {
     assert!(precision > 0.98, "{precision}");
     assert!(auto_recall > 0.85, "{auto_recall}");
     assert!(auto_precision > 0.98, "{auto_precision}");
+}
+
+#[test]
+fn an_automatic_vote_that_cannot_resolve_the_flow_is_not_used() {
+    // A steady cellular array of vortices (u = U sin kx cos ky, v = −U cos kx sin ky) with
+    // cells 70 px across, about one voting cell: displacements up to 5 px (0.36 of the 14 px
+    // spacing), enough for the automatic decision to consider the vote, but the flow turns
+    // within each voting cell, so most cells find no single peak.
+    let (u, k) = (5.0, std::f64::consts::PI / 70.0);
+    let path = move |p0: Point2, t: f64| {
+        let mut p = p0;
+        let steps = (20.0 * t) as usize;
+        for _ in 0..steps {
+            let v = Vec2::new(
+                u * (k * p.x).sin() * (k * p.y).cos(),
+                -u * (k * p.x).cos() * (k * p.y).sin(),
+            );
+            p = p + v * 0.05;
+        }
+        p
+    };
+    let scene = Scene::new(9, 400, 12, jittered_lattice(14.0), path, 1.0, 0);
+    let mut auto = PtvTracker::new(PtvParams::default()).unwrap();
+    let automatic = scene.feed(&mut auto, PassDirection::Forward);
+    let share = auto.measured_vote_valid_share().unwrap();
+    let displacement = auto.measured_displacement().unwrap();
+    eprintln!("valid share {share:.3}, 95 % of displacements within {displacement:.2} px");
+    assert!(share < AUTO_VOTE_MIN_VALID_SHARE, "{share}");
+    assert!(
+        displacement >= AUTO_VOTE_FIRST_LINK_SPACINGS * 14.0,
+        "{displacement}"
+    );
+    assert_eq!(auto.vote_radius(), None);
+    // Started from rest, as TracTrac does: the same tracks as with voting off.
+    let off = scene.track(PtvParams {
+        vote_search_px: VoteSearch::OFF,
+        ..Default::default()
+    });
+    assert!(
+        automatic == off,
+        "the automatic run differs from the run with voting off"
+    );
 }
 
 #[test]

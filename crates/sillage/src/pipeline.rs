@@ -108,6 +108,10 @@ pub struct RunSummary {
     /// PTV with `vote_search_px = "auto"`: the displacement measured on the first two frames
     /// (95th percentile, px).
     pub measured_displacement_px: Option<f64>,
+    /// PTV with `vote_search_px = "auto"`: the share of the points whose cell of that first
+    /// vote found its own displacement; below `AUTO_VOTE_MIN_VALID_SHARE` (0.5) the vote was
+    /// not used.
+    pub vote_valid_share: Option<f64>,
     /// PTV: displacement voting's search radius in use at the end of the run (`None`: off).
     pub vote_search_px: Option<f64>,
 }
@@ -424,6 +428,7 @@ impl Pipeline {
         };
         if let AnyTracker::Ptv(tracker) = &self.tracker {
             totals.measured_displacement_px = tracker.measured_displacement();
+            totals.vote_valid_share = tracker.measured_vote_valid_share();
             totals.vote_search_px = tracker.vote_radius();
         }
         if timings.frames > 0 {

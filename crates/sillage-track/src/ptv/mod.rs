@@ -21,7 +21,7 @@ mod tracker;
 mod voting;
 
 pub use params::{
-    AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_SPACINGS, PtvParams, VoteMode,
-    VoteSearch,
+    AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_MIN_VALID_SHARE, AUTO_VOTE_SPACINGS,
+    AUTO_VOTE_UNRESOLVED_SPACINGS, PtvParams, VoteMode, VoteSearch,
 };
 pub use tracker::{PassDirection, PtvTracker};

@@ -120,7 +120,9 @@ impl VoteSearch {
     /// four (16–64 px) when the displacements reach 70 % of that radius: when the 95th percentile of the voted displacements reaches
     /// [`AUTO_VOTE_FIRST_LINK_SPACINGS`] of the spacing the vote predicts the first link, and
     /// when it reaches [`AUTO_VOTE_SPACINGS`] voting stays on with a search radius of
-    /// [`AUTO_VOTE_MARGIN`] × that displacement; else it is off.
+    /// [`AUTO_VOTE_MARGIN`] × that displacement; else it is off. A vote that resolved less
+    /// than [`AUTO_VOTE_MIN_VALID_SHARE`] of the points is not used at all, unless the
+    /// displacements reach [`AUTO_VOTE_UNRESOLVED_SPACINGS`].
     pub const AUTO: VoteSearch = VoteSearch::Mode(VoteMode::Auto);
 }
 
@@ -147,6 +149,32 @@ pub const AUTO_VOTE_FIRST_LINK_SPACINGS: f64 = 0.2;
 /// mean spacing: p⁻¹ ≳ 0.5, where nearest neighbours start to fail (see `voting` and the
 /// paper's fast-flow case). Not tuned: on the tune half of the family no case reaches it.
 pub const AUTO_VOTE_SPACINGS: f64 = 0.5;
+
+/// The automatic vote is used (to predict the first link and seed the motion model, or to
+/// stay on) only when at least this share of the points lie in voting cells that found their
+/// own displacement — a significant histogram peak that passed the normalised median test,
+/// PIV's valid-vector ratio. Where the flow turns within a cell (a cellular array of
+/// vortices about twice the cell across), the cell's points disagree, most cells find no peak
+/// and take their neighbours' vector: that field is made up, and a model seeded with it
+/// keeps linking wrongly for many frames. Then the run starts as TracTrac does, from rest.
+///
+/// Tuned on the **tune** half of `sillage::ptv_accuracy_bench::moderate_family`
+/// (24 cases, 512², 10 frames, displacements 0.3–0.6 of the spacing; mean true / false
+/// recoveries): no test 76.8 / 8.0 %, 0.3 78.5 / 6.6, 0.4 79.0 / 6.4, **0.5 79.3 / 6.4**, 0.6
+/// 78.9 / 6.6, 0.7 78.7 / 6.7, never voting 76.1 / 8.1 (the test gating both uses; gating
+/// only the first link: 0.5 78.1 / 7.3). Unseen, on its **report** half (24 cases): 78.0 / 7.9
+/// → 79.9 / 6.0 %, cases within 2 points of the per-case tuned true recovery 7 → 9 (only
+/// cellular arrays change, e.g. 53.3 / 14.1 → 68.1 / 8.3 and 16.5 / 55.2 → 43.5 / 16.0);
+/// both halves of `family` unchanged (46.1 / 25.2 % on its report half).
+pub const AUTO_VOTE_MIN_VALID_SHARE: f64 = 0.5;
+
+/// From this many mean spacings of displacement (95th percentile) on, the automatic vote is
+/// used even when it resolved less than [`AUTO_VOTE_MIN_VALID_SHARE`] of the points: there a
+/// start from rest links almost every particle to a neighbour, and even a partly resolved vote
+/// does better (a fast vortex at p⁻¹ ≈ 4.5 resolves 49.5 % of its points: its rim moves
+/// beyond the first search). Not tuned (p⁻¹ ≈ 1, where nearest neighbours fail); no case of
+/// either tune half reaches it.
+pub const AUTO_VOTE_UNRESOLVED_SPACINGS: f64 = 1.0;
 
 /// The automatic search radius is this multiple of the measured displacement (95th
 /// percentile), so that faster particles of the same flow are still searched.

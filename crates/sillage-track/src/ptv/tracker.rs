@@ -10,8 +10,8 @@ use sillage_core::{
 use super::filter::{INITIAL_THRESHOLD, log10_error, updated_threshold};
 use super::motion::{MotionField, Samples};
 use super::params::{
-    AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_SPACINGS, PtvParams, VoteMode,
-    VoteSearch,
+    AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_MIN_VALID_SHARE, AUTO_VOTE_SPACINGS,
+    AUTO_VOTE_UNRESOLVED_SPACINGS, PtvParams, VoteMode, VoteSearch,
 };
 use super::voting::{Vote, mean_spacing, voted_displacements};
 
@@ -146,6 +146,9 @@ pub struct PtvTracker {
     followed_decision: Option<Option<f64>>,
     /// The displacement (95th percentile, px) the automatic decision measured.
     measured_displacement: Option<f64>,
+    /// The automatic decision's vote: share of the points whose cell found its own peak.
+    #[serde(default)]
+    measured_valid_share: Option<f64>,
     forward: Vec<Option<Neighbour>>,
     two_nearest: Vec<Vec<Neighbour>>,
     link12: Vec<Option<usize>>,
@@ -198,6 +201,7 @@ impl PtvTracker {
             vote_decided: vote != VoteSearch::Mode(VoteMode::Auto),
             followed_decision: None,
             measured_displacement: None,
+            measured_valid_share: None,
             forward: Vec::new(),
             two_nearest: Vec::new(),
             link12: Vec::new(),
@@ -233,6 +237,13 @@ impl PtvTracker {
     /// percentile, px).
     pub fn measured_displacement(&self) -> Option<f64> {
         self.measured_displacement
+    }
+
+    /// The share of the points whose voting cell found its own displacement in the automatic
+    /// decision's vote (PIV's valid-vector ratio); below [`AUTO_VOTE_MIN_VALID_SHARE`] the
+    /// vote is not used.
+    pub fn measured_vote_valid_share(&self) -> Option<f64> {
+        self.measured_valid_share
     }
 
     /// Starts a new pass over the sequence in `direction` (TracTrac's `vid_loop`): forgets
@@ -338,7 +349,9 @@ impl PtvTracker {
     /// from zero motion over four spacings measures the displacements (95th percentile).
     /// When they reach [`AUTO_VOTE_FIRST_LINK_SPACINGS`] of the spacing, the vote predicts this
     /// first link (and seeds the motion model), as voting does; when they reach
-    /// [`AUTO_VOTE_SPACINGS`], voting stays on for the rest of the run.
+    /// [`AUTO_VOTE_SPACINGS`], voting stays on for the rest of the run. Neither when the vote
+    /// resolved less than [`AUTO_VOTE_MIN_VALID_SHARE`] of the points, unless the
+    /// displacements reach [`AUTO_VOTE_UNRESOLVED_SPACINGS`].
     fn decide_voting(&mut self, dt: f64) {
         self.vote_decided = true;
         let spacing = mean_spacing(&self.c1);
@@ -358,16 +371,21 @@ impl PtvTracker {
         };
         let p95 = percentile_norm(&self.voted, 0.95);
         self.measured_displacement = Some(p95);
-        if p95 >= AUTO_VOTE_FIRST_LINK_SPACINGS * spacing {
+        self.measured_valid_share = Some(vote.valid_share);
+        // A vote that could not resolve the flow (most of its cells took their neighbours'
+        // displacement) would seed the model with a field it made up: TracTrac's start,
+        // unless the particles move a spacing or more, where a start from rest cannot work.
+        let resolved = vote.valid_share >= AUTO_VOTE_MIN_VALID_SHARE
+            || p95 >= AUTO_VOTE_UNRESOLVED_SPACINGS * spacing;
+        if resolved && p95 >= AUTO_VOTE_FIRST_LINK_SPACINGS * spacing {
             self.displacements.clear();
             self.displacements.resize(self.c1.len(), Vec2::ZERO);
             self.apply_votes(&vote, false, dt);
         }
         self.vote_radius = match self.followed_decision {
             Some(radius) => radius,
-            None => {
-                (p95 >= AUTO_VOTE_SPACINGS * spacing).then(|| (AUTO_VOTE_MARGIN * p95).max(1.0))
-            }
+            None => (resolved && p95 >= AUTO_VOTE_SPACINGS * spacing)
+                .then(|| (AUTO_VOTE_MARGIN * p95).max(1.0)),
         };
     }
 

@@ -46,6 +46,11 @@ pub(crate) struct Vote {
     pub resolution_px: f64,
     /// Mean spacing between the points of `a`, `√(area / n)`, px.
     pub spacing_px: f64,
+    /// Share of the points of `a` whose first-pass cell found its own displacement (a
+    /// significant peak that passed the median test), in `[0, 1]`; the others took their
+    /// neighbours'. PIV's valid-vector ratio: low when the flow varies too much within a
+    /// cell for its points to agree on one displacement.
+    pub valid_share: f64,
 }
 
 /// The displacement from frame `a` to frame `b` at each point of `a`, written to `out`
@@ -76,7 +81,15 @@ pub(crate) fn voted_displacements(
             &zero
         }
     };
-    let coarse = vote_field(a, b, prior, &coarse_grid, search_px, bin)?;
+    let (coarse, valid) = vote_field(a, b, prior, &coarse_grid, search_px, bin)?;
+    let valid_points = a
+        .iter()
+        .filter(|&&p| {
+            let (cx, cy) = coarse_grid.cell_of(p);
+            valid[cy * coarse_grid.nx + cx]
+        })
+        .count();
+    let valid_share = valid_points as f64 / a.len() as f64;
     let refined: Vec<Vec2> = a
         .iter()
         .zip(prior)
@@ -86,7 +99,7 @@ pub(crate) fn voted_displacements(
     let fine_bin = (bin * REFINE_BIN_SHARE).max(MIN_BIN_PX);
     let fine_radius = bin * REFINE_RADIUS_BINS;
     match vote_field(a, b, &refined, &fine_grid, fine_radius, fine_bin) {
-        Some(fine) => {
+        Some((fine, _)) => {
             out.extend(
                 a.iter()
                     .zip(&refined)
@@ -95,6 +108,7 @@ pub(crate) fn voted_displacements(
             Some(Vote {
                 resolution_px: fine_bin,
                 spacing_px,
+                valid_share,
             })
         }
         None => {
@@ -102,6 +116,7 @@ pub(crate) fn voted_displacements(
             Some(Vote {
                 resolution_px: bin,
                 spacing_px,
+                valid_share,
             })
         }
     }
@@ -216,7 +231,8 @@ impl Grid {
 
 /// One voting pass: per cell of `grid`, the residual displacement of its points of `a`
 /// beyond their `prior`, searched within `radius` of each point's `prior` displacement with bins of `bin`
-/// px; invalid cells are filled from their neighbours. `None` when no cell has a peak.
+/// px; invalid cells are filled from their neighbours. With the field, which cells found
+/// their own (valid) displacement. `None` when no cell has a peak.
 fn vote_field(
     a: &[Point2],
     b: &[Point2],
@@ -224,7 +240,7 @@ fn vote_field(
     grid: &Grid,
     radius: f64,
     bin: f64,
-) -> Option<Vec<Vec2>> {
+) -> Option<(Vec<Vec2>, Vec<bool>)> {
     let (a_starts, a_order) = grid.bucket(a);
     let search = SearchGrid::new(grid, b, radius);
     let half = (radius / bin).ceil() as usize;
@@ -268,7 +284,8 @@ fn vote_field(
         },
     );
     reject_outliers(&mut field, grid, bin);
-    fill_gaps(field, grid)
+    let valid = field.iter().map(Option::is_some).collect();
+    fill_gaps(field, grid).map(|field| (field, valid))
 }
 
 /// The points of frame `b` bucketed for the pair search: cells about half the search radius
@@ -524,11 +541,38 @@ mod tests {
         let shift = Vec2::new(23.3, -17.8);
         let b: Vec<Point2> = a.iter().map(|&p| p + shift).collect();
         let mut out = Vec::new();
-        assert!(voted_displacements(&a, &b, None, 40.0, &mut out).is_some());
+        let vote = voted_displacements(&a, &b, None, 40.0, &mut out).unwrap();
         assert_eq!(out.len(), a.len());
         for d in &out {
             assert!((*d - shift).norm() < 0.05, "{d:?}");
         }
+        // Every cell agrees on the one displacement.
+        assert!(vote.valid_share > 0.95, "{}", vote.valid_share);
+    }
+
+    #[test]
+    fn a_flow_turning_within_the_cells_is_not_resolved() {
+        // A cellular array of vortices (ψ ∝ sin kx · sin ky) whose cells, 64 px across, are
+        // about as wide as the voting cells (≈ 49 px here): the displacement spans ±5 px
+        // within a voting cell, so few cells find one peak.
+        let a = random_points(4000, 512.0);
+        let k = std::f64::consts::PI / 64.0;
+        let b: Vec<Point2> = a
+            .iter()
+            .map(|&p| {
+                p + Vec2::new(
+                    5.0 * (k * p.x).sin() * (k * p.y).cos(),
+                    -5.0 * (k * p.x).cos() * (k * p.y).sin(),
+                )
+            })
+            .collect();
+        let mut out = Vec::new();
+        let vote = voted_displacements(&a, &b, None, 12.0, &mut out).unwrap();
+        assert!(vote.valid_share < 0.5, "{}", vote.valid_share);
+        // The same points shifted as a whole are resolved.
+        let shifted: Vec<Point2> = a.iter().map(|&p| p + Vec2::new(4.0, -3.0)).collect();
+        let vote = voted_displacements(&a, &shifted, None, 12.0, &mut out).unwrap();
+        assert!(vote.valid_share > 0.95, "{}", vote.valid_share);
     }
 
     #[test]
