@@ -43,11 +43,12 @@ fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
     let dir = tempfile::tempdir().unwrap();
     let frames = dir.path().join("vortex");
     common::synth_vortex(&frames, 12, 800, (512, 512), &[]);
-    // Changed once on purpose: the blob scale and polarity are measured from the frames by
-    // default (issue "PTV that needs no hand tuning"); they were fixed at 2 px, bright.
+    // Changed on purpose: the blob scale and polarity are measured from the frames by
+    // default (issue "PTV that needs no hand tuning"; they were fixed at 2 px, bright), and
+    // the automatic scale became √(0.7σ̂) instead of √(0.8σ̂) (2026-11-28).
     let expected = [
-        ("tracks_track.txt", 0x3a1b_ba26_641f_8806_u64),
-        ("tracks.csv", 0x27ed_ab62_f9b0_e006),
+        ("tracks_track.txt", 0x31eb_32ef_bf3d_a38c_u64),
+        ("tracks.csv", 0xd347_38b6_2e65_e8a4),
     ];
     for (name, hash) in expected {
         let out = dir.path().join(name);
