@@ -93,7 +93,7 @@ impl From<Polarity> for PolarityChoice {
 /// 512², 10 frames; `tests/ptv_family_tuning.rs`), by the issue's own criterion: the cases
 /// whose true recovery is within 2 points of the per-case tuned one (a grid over δ, the
 /// threshold and the outlier filter), with δ given explicitly: √(0.4σ̂) 26 of 36, √(0.5σ̂)
-/// 28, √(0.6σ̂) 27, **√(0.7σ̂) 24**, √(0.8σ̂) 21 (mean true / false 70.8 / 11.1, 72.5 / 9.8,
+/// 28, √(0.6σ̂) 27, **√(0.7σ̂) 24**, √(0.8σ̂) 21 (mean true / false 70.8 / 11.1, 72.4 / 9.8,
 /// 72.9 / 9.1, 72.9 / 8.8, 72.3 / 8.8 %), under the constraint that isolated particles keep
 /// within 1.5× the Cramér–Rao bound at every σ from 0.7 to 3 px (`tests/localisation.rs`):
 /// at 0.6 σ = 0.7 px reaches 1.50× (SNR 20), at 0.7 1.35×. A threshold `k` of 3 and
