@@ -124,7 +124,8 @@ pub fn run(args: &PtvArgs) -> Result<()> {
                 ", {:.0} % of the points in cells the vote resolved{}",
                 100.0 * share,
                 if share < AUTO_VOTE_MIN_VALID_SHARE {
-                    " (too few: the flow varies within a voting cell, so the vote is not used)"
+                    " (under half: the flow varies within a voting cell, so the vote is used \
+                     only for displacements of a spacing or more)"
                 } else {
                     ""
                 }
