@@ -161,10 +161,7 @@ fn print_means(rows: &[FamilyRow]) {
         .filter_map(|r| r.tuned.map(|(_, t)| (r, t)))
         .collect();
     if tuned.len() == rows.len() {
-        let within = tuned
-            .iter()
-            .filter(|(r, t)| r.defaults.true_pct >= t.true_pct - 2.0)
-            .count();
+        let within = tuned.iter().filter(|(r, t)| r.defaults.near(t)).count();
         let sparse: Vec<_> = rows.iter().filter(|r| r.case.density_ppp <= 0.02).collect();
         let clean = sparse
             .iter()

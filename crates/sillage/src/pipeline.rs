@@ -110,7 +110,7 @@ pub struct RunSummary {
     pub measured_displacement_px: Option<f64>,
     /// PTV with `vote_search_px = "auto"`: the share of the points whose cell of that first
     /// vote found its own displacement; below `AUTO_VOTE_MIN_VALID_SHARE` (0.5) the vote was
-    /// not used.
+    /// used only if the displacements reached a spacing.
     pub vote_valid_share: Option<f64>,
     /// PTV: displacement voting's search radius in use at the end of the run (`None`: off).
     pub vote_search_px: Option<f64>,

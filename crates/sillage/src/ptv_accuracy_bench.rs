@@ -267,7 +267,15 @@ impl Recoveries {
     pub fn merit(&self) -> f64 {
         self.true_pct - self.false_pct
     }
+
+    /// The bar: a true recovery within [`NEAR_TUNED_POINTS`] of `tuned`'s.
+    pub fn near(&self, tuned: &Recoveries) -> bool {
+        self.true_pct >= tuned.true_pct - NEAR_TUNED_POINTS
+    }
 }
+
+/// How far below the per-case tuned true recovery the defaults may stay, points of %.
+pub const NEAR_TUNED_POINTS: f64 = 2.0;
 
 /// One row of the table.
 #[derive(Debug, Clone, Serialize)]

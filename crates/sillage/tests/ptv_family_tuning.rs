@@ -51,7 +51,7 @@ fn blob_scale_variants_on_the_tune_halves() {
             line.join(" ")
         );
         for (k, r) in results.iter().enumerate() {
-            within[k] += usize::from(r.true_pct >= tuned.true_pct - 2.0);
+            within[k] += usize::from(r.near(&tuned));
             sums[k].0 += r.true_pct;
             sums[k].1 += r.false_pct;
         }
