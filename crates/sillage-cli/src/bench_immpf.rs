@@ -42,9 +42,11 @@ pub struct BenchImmpfArgs {
     /// Track `det/det.txt` alone (no frames): for sequences without images.
     #[arg(long)]
     pub detections_only: bool,
-    /// With frames, start trackers on `det/det.txt` instead of motion blobs.
-    #[arg(long)]
-    pub births_from_detections: bool,
+    /// With frames, also read `det/det.txt`: the measurements that drive the trackers, the
+    /// frames adding colour (or only the births, instead of motion blobs, with `--set
+    /// tracker.detection.with_frames=births`).
+    #[arg(long, alias = "births-from-detections")]
+    pub with_detections: bool,
     /// Ground plane for box sizes (see `sillage track immpf --ground-plane`).
     #[arg(long, value_name = "FILE")]
     pub ground_plane: Option<PathBuf>,
@@ -84,7 +86,7 @@ pub fn run(args: &BenchImmpfArgs) -> Result<()> {
         .collect::<sillage::core::Result<Vec<_>>>()?;
     let input = BenchInput {
         detections_only: args.detections_only,
-        births_from_detections: args.births_from_detections,
+        with_detections: args.with_detections,
         max_frames: args.max_frames,
         skip_baselines: false,
     };

@@ -1,5 +1,6 @@
 //! `sillage track immpf`: pedestrians with one IMM particle filter each (Madrigal & Hayet),
-//! on colour frames (motion blobs or `--detections` as births) or on detections alone;
+//! on colour frames (motion blobs as births), on detections beside the frames, or on
+//! detections alone;
 //! writes MOTChallenge results and, with `--model-weights`, the model weights πₘ per row.
 
 use std::path::PathBuf;
@@ -24,8 +25,11 @@ pub struct TrackImmpfArgs {
     /// `--detections` alone are tracked.
     #[arg(required_unless_present = "detections")]
     pub input: Option<String>,
-    /// MOTChallenge detections (`frame,-1,left,top,width,height,score,...`): the birth
-    /// candidates instead of motion blobs; without frames, also the measurements.
+    /// MOTChallenge detections (`frame,-1,left,top,width,height,score,...`): the
+    /// measurements that drive the trackers, alone or beside the frames (which then add
+    /// colour: `tracker.detection.colour_weight`); with `--set
+    /// tracker.detection.with_frames=births`, only the birth candidates instead of motion
+    /// blobs.
     #[arg(long, value_name = "FILE")]
     pub detections: Option<PathBuf>,
     /// Frame size `WxH` for detections alone (default: the `seqinfo.ini` of a MOTChallenge

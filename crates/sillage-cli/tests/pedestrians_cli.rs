@@ -339,3 +339,66 @@ fn bad_inputs_are_refused_with_the_file_named() {
     ]);
     assert!(message.contains("motion prior"), "{message}");
 }
+
+/// Detections beside the frames drive the trackers (`tracker.detection.with_frames`, default
+/// `measurements`): with the default colour weight 0 the result file is the one of the
+/// detections alone; `births` gives the image mode; an unknown role is refused by name.
+#[test]
+fn detections_beside_frames_are_measurements_by_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let (beside, alone, births) = (
+        dir.path().join("beside.txt"),
+        dir.path().join("alone.txt"),
+        dir.path().join("births.txt"),
+    );
+    let detections = format!("{PETS}/det/det.txt");
+    let frames = format!("{PETS}/img1");
+    let common = ["--detections", &detections, "--max-frames", "30"];
+    run_ok(
+        &[
+            &["track", "immpf", &frames][..],
+            &common,
+            &["--out", path_str(&beside)],
+        ]
+        .concat(),
+    );
+    run_ok(
+        &[
+            &["track", "immpf"][..],
+            &common,
+            &["--out", path_str(&alone)],
+        ]
+        .concat(),
+    );
+    let beside_rows = fs::read_to_string(&beside).unwrap();
+    assert!(beside_rows.lines().count() > 50, "{beside_rows}");
+    assert_eq!(beside_rows, fs::read_to_string(&alone).unwrap());
+    let as_births = ["--set", "tracker.detection.with_frames=births"];
+    run_ok(
+        &[
+            &["track", "immpf", &frames][..],
+            &common,
+            &as_births,
+            &["--out", path_str(&births)],
+        ]
+        .concat(),
+    );
+    assert_ne!(beside_rows, fs::read_to_string(&births).unwrap());
+    let message = run_user_error(
+        &[
+            &["track", "immpf", &frames][..],
+            &common,
+            &[
+                "--set",
+                "tracker.detection.with_frames=sideways",
+                "--out",
+                path_str(&births),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(
+        message.contains("with_frames") || message.contains("sideways"),
+        "{message}"
+    );
+}

@@ -151,6 +151,7 @@ fn run(params: &PedestrianParams, scene: Scene, seed: u64) -> Vec<PedestrianEsti
             } else {
                 &candidates
             },
+            candidates_are_detections: !images,
         };
         tracker.step(&observations, &mut out).unwrap();
     }
@@ -256,6 +257,7 @@ fn frames_out_of_order_and_bad_parameters_are_refused() {
         frame,
         cues: None,
         candidates: &[],
+        candidates_are_detections: true,
     };
     let mut out = Vec::new();
     tracker.step(&frame(3), &mut out).unwrap();
@@ -391,6 +393,7 @@ fn a_tracker_lost_as_a_duplicate_at_a_crossing_gives_its_identity_back() {
                 frame,
                 cues: None,
                 candidates: &candidates,
+                candidates_are_detections: true,
             };
             tracker.step(&observations, &mut out).unwrap();
         }
@@ -456,6 +459,7 @@ fn a_walker_who_speeds_up_behind_a_wall_keeps_its_identity() {
                 frame: frame as u64,
                 cues: Some(&cues),
                 candidates: &candidates,
+                candidates_are_detections: false,
             };
             tracker.step(&observations, &mut out).unwrap();
         }
@@ -513,6 +517,7 @@ fn on_detections_seeded(
             frame,
             cues: None,
             candidates: &candidates,
+            candidates_are_detections: true,
         };
         tracker.step(&observations, &mut out).unwrap();
     }
@@ -637,4 +642,98 @@ fn the_first_two_detections_give_a_fast_walker_its_velocity() {
         broken >= 3,
         "{broken} of 5 seeds broke up without the proposal"
     );
+}
+
+/// Foot x of walker `k` of a meeting: they walk face to face at 3 px a frame until frame 19,
+/// 6 px apart (the second hiding most of the first), then walk back the way they came.
+fn meeting_x(k: usize, frame: usize) -> f64 {
+    let (start, v) = [(100.0, 3.0), (220.0, -3.0)][k];
+    let t = frame.min(19) as f64 - frame.saturating_sub(19) as f64;
+    start + v * t
+}
+
+/// The meeting's two walkers (red over blue, green over yellow), foot y 150, 16 × 48 px.
+fn meeting_person(k: usize, frame: usize) -> Person {
+    let b = BoundingBox::standing_on(
+        sillage_core::Point2::new(meeting_x(k, frame), 150.0),
+        16.0,
+        48.0,
+    );
+    let (_, _, _, top, bottom) = WALKERS[k];
+    (b, top, bottom)
+}
+
+/// The meeting tracked on its rendered frames with both walkers' boxes as detections on
+/// every frame (`with_frames`), or on the detections alone.
+fn meeting(params: &PedestrianParams, with_frames: bool, seed: u64) -> Vec<PedestrianEstimate> {
+    let mut tracker =
+        PedestrianTracker::new(params, BoxSizing::FromCandidate, None, (W, H), seed).unwrap();
+    let (mut cues, mut previous, mut out) = (FrameCues::default(), None, Vec::new());
+    for frame in 0..40 {
+        let people = [meeting_person(0, frame), meeting_person(1, frame)];
+        see(
+            &mut cues,
+            params,
+            render_people(frame, &people, None),
+            &mut previous,
+        );
+        let candidates: Vec<Candidate> = people
+            .iter()
+            .map(|&(bbox, _, _)| Candidate { bbox, score: 1.0 })
+            .collect();
+        let observations = PedestrianFrame {
+            frame: frame as u64,
+            cues: with_frames.then_some(&cues),
+            candidates: &candidates,
+            candidates_are_detections: true,
+        };
+        tracker.step(&observations, &mut out).unwrap();
+    }
+    out
+}
+
+/// (track, walker) pairs of the meeting's estimates away from the meeting itself (frames
+/// 16-24, where the boxes overlap), each estimate's walker by IoU ≥ 0.5.
+fn meeting_identities(estimates: &[PedestrianEstimate]) -> Vec<(u64, usize)> {
+    let mut pairs: Vec<(u64, usize)> = estimates
+        .iter()
+        .filter(|e| !(16..=24).contains(&e.frame))
+        .filter_map(|e| {
+            (0..2)
+                .find(|&k| e.bbox.iou(&meeting_person(k, e.frame as usize).0) >= 0.5)
+                .map(|k| (e.track_id, k))
+        })
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
+}
+
+/// Detections beside frames drive the trackers as detections alone do: with the colour
+/// weight at 0 the frames change nothing, estimate for estimate.
+#[test]
+fn detections_beside_frames_track_as_detections_alone_without_colour() {
+    let params = PedestrianParams::default();
+    assert_eq!(params.detection.colour_weight, 0.0);
+    assert_eq!(meeting(&params, true, 4), meeting(&params, false, 4));
+}
+
+/// Two walkers meet face to face and walk back: the predicted boxes carry on into each
+/// other, and the first detections after the turn overlap both equally, so on IoU alone the
+/// identities swap for some seeds; with the colour distance in the assignment each tracker
+/// keeps its own walker for every seed.
+#[test]
+fn colour_in_the_assignment_keeps_identities_when_walkers_meet_and_turn_back() {
+    let mut params = PedestrianParams::default();
+    params.detection.min_hits = 3;
+    let own = [(1, 0), (2, 1)];
+    let swapped = (1..=6)
+        .filter(|&seed| meeting_identities(&meeting(&params, true, seed)) != own)
+        .count();
+    assert!(swapped > 0, "on IoU alone no seed of six swapped");
+    params.detection.colour_weight = 1.0;
+    for seed in 1..=6 {
+        let pairs = meeting_identities(&meeting(&params, true, seed));
+        assert_eq!(pairs, own, "seed {seed}");
+    }
 }

@@ -249,8 +249,9 @@ def track(source: str | Any, tracker: str = "ptv", *, seed: int = 1,
     * ``"bedload"``: the MMPF+ bead tracker on the bead detector's output, with motion
       states; give the bead sizes with ``sequence_params`` (BeadTracking's
       ``sequence_param.txt``) and the flume base with ``mask``;
-    * ``"immpf"``: pedestrians, one IMM particle filter each (motion blobs, or the
-      MOTChallenge ``detections`` file, as births); ``ground_plane`` (from
+    * ``"immpf"``: pedestrians, one IMM particle filter each (motion blobs as births, or
+      the MOTChallenge ``detections`` file driving the filters; ``params=
+      {"tracker.detection.with_frames": "births"}`` for births only); ``ground_plane`` (from
       ``sillage fit homography``) sizes the boxes, ``motion_prior`` feeds the MP model;
     * ``"siftpf"``: surveillance objects followed by their SIFT features' particle filters.
 

@@ -225,6 +225,14 @@ impl Appearance {
         self.motion.as_ref().map(|h| 1.0 - f64::from(h[0]))
     }
 
+    /// `(d²_top + d²_bottom) / 2` between two appearances, in `[0, 1]`: the mean squared
+    /// Bhattacharyya distance of their halves' colour histograms (§4.3's d², the motion
+    /// histograms left out).
+    pub fn colour_distance(&self, other: &Appearance) -> f64 {
+        let d2 = |a: &[f32], b: &[f32]| (1.0 - bhattacharyya_coefficient(a, b)).max(0.0);
+        (d2(&self.top, &other.top) + d2(&self.bottom, &other.bottom)) / 2.0
+    }
+
     /// `−λ_c (d²_top + d²_bottom)` of `person`, the colour part of the likelihood; `None`
     /// when a half of the box holds no pixel. The histograms of the top and bottom halves
     /// are left in `scratch`.

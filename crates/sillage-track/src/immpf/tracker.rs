@@ -1,9 +1,9 @@
 //! The multi-pedestrian tracker of the IMM-PF paper: one IMM particle filter per person
 //! (§4). On frames, born on motion blobs or detections that no tracker explains, scored by
 //! colour and motion histograms (§4.3), and removed when the mean likelihood of its
-//! particles stays low for some frames (§5.3); without frames, the detections are assigned
-//! to the filters' predicted boxes and weigh them, with SORT's and ByteTrack's life cycle
-//! (`on_detections`).
+//! particles stays low for some frames (§5.3); on detections (alone, or with frames adding
+//! each person's colour), the detections are assigned to the filters' predicted boxes and
+//! weigh them, with SORT's and ByteTrack's life cycle (`on_detections`).
 
 mod on_detections;
 
@@ -19,7 +19,7 @@ use sillage_filter::{
 
 use super::appearance::{Appearance, FrameCues, HistogramScratch};
 use super::models::PedestrianMotion;
-use super::params::{ModelName, PedestrianParams, REVIVAL_GATE_AT_DEATH};
+use super::params::{DetectionsWithFrames, ModelName, PedestrianParams, REVIVAL_GATE_AT_DEATH};
 use super::sizing::BoxSizing;
 use sillage_core::BoundingBox;
 
@@ -43,6 +43,10 @@ pub struct PedestrianFrame<'a> {
     pub cues: Option<&'a FrameCues>,
     /// Motion blobs or detections of the frame.
     pub candidates: &'a [Candidate],
+    /// Whether the candidates come from a person detector (a MOTChallenge `det.txt`) rather
+    /// than from motion blobs: with frames, detections then drive the trackers
+    /// (`detection.with_frames`).
+    pub candidates_are_detections: bool,
 }
 
 /// One person's estimate in one frame.
@@ -230,9 +234,14 @@ impl PedestrianTracker {
             .filter(|c| c.bbox.is_valid() && c.score >= self.params.detection.min_score)
             .copied()
             .collect();
-        let Some(cues) = frame.cues else {
-            self.step_on_detections(frame.frame, &candidates, out);
-            return Ok(());
+        let detections_drive = frame.candidates_are_detections
+            && self.params.detection.with_frames == DetectionsWithFrames::Measurements;
+        let cues = match frame.cues {
+            Some(cues) if !detections_drive => cues,
+            cues => {
+                self.step_on_detections(frame.frame, &candidates, cues, out);
+                return Ok(());
+            }
         };
         self.predict_and_correct(cues, &candidates);
         self.count_support(&candidates);

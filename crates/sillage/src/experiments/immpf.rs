@@ -94,8 +94,9 @@ pub struct Row {
 pub struct BenchInput {
     /// Track `det/det.txt` alone (no frames).
     pub detections_only: bool,
-    /// With frames, start trackers on `det/det.txt` instead of motion blobs.
-    pub births_from_detections: bool,
+    /// With frames, also read `det/det.txt` (as measurements or births, by
+    /// `tracker.detection.with_frames`).
+    pub with_detections: bool,
     /// Use the first N frames of each sequence.
     pub max_frames: Option<usize>,
     /// Leave out the SORT and ByteTrack rows (already benched on the same sequences).
@@ -213,7 +214,7 @@ impl Sequence {
         };
         let mut source = PedestrianInput::open(
             images.as_deref(),
-            (input.births_from_detections || !use_images).then_some(detections.as_path()),
+            (input.with_detections || !use_images).then_some(detections.as_path()),
             frame_size_beside(&detections),
             motion,
             &params.appearance,

@@ -137,6 +137,7 @@ pub fn step(
         frame: prepared.frame,
         cues: prepared.cues.as_ref(),
         candidates: &prepared.candidates,
+        candidates_are_detections: prepared.candidates_are_detections,
     };
     tracker
         .step(&frame, out)

@@ -20,6 +20,8 @@ pub struct PreparedFrame {
     pub cues: Option<FrameCues>,
     /// Birth candidates (and, without cues, the measurements).
     pub candidates: Vec<Candidate>,
+    /// Whether the candidates are detections (from `--detections`) rather than motion blobs.
+    pub candidates_are_detections: bool,
     /// The colour frame, kept only when asked for (`keep_colour`, for overlays).
     pub colour: Option<RgbImage>,
 }
@@ -173,6 +175,7 @@ impl PedestrianInput {
                 frame,
                 cues: None,
                 candidates,
+                candidates_are_detections: true,
                 colour: None,
             }));
         };
@@ -216,6 +219,7 @@ impl PedestrianInput {
             frame: frame.index,
             cues: Some(cues),
             candidates,
+            candidates_are_detections: self.detections.is_some(),
             colour: if self.keep_colour {
                 frame.colour.take()
             } else {

@@ -1,7 +1,9 @@
-//! The detections-only mode of the pedestrian tracker: no frames, the detections are both the
-//! births and the measurements. Each person keeps its IMM particle filter (the competing
-//! motion models of the paper predict where its box goes); the detections are assigned to the
-//! predicted boxes by the Hungarian algorithm on IoU in two stages — the confident detections
+//! The detection-driven mode of the pedestrian tracker: the detections are both the births and
+//! the measurements, alone or with colour frames. Each person keeps its IMM particle filter
+//! (the competing motion models of the paper predict where its box goes); the detections are
+//! assigned to the predicted boxes by the Hungarian algorithm on IoU — with frames, IoU and
+//! the colour distance to the person's reference histograms (§4.3) — in two stages — the
+//! confident detections
 //! to every tracker, then the weak ones to the trackers that a detection held in the previous
 //! frame (ByteTrack's idea: a partly occluded person scores low) — and a tracker's life
 //! follows SORT and ByteTrack: confirmed after `min_hits` matches in a row (its earlier frames
@@ -15,7 +17,7 @@ use sillage_core::{BoundingBox, FrameIndex, Point2};
 
 use super::{Candidate, PedestrianEstimate, PedestrianTracker, Track, estimate_foot, estimate_of};
 use crate::bytetrack::assign;
-use crate::immpf::DetectionLikelihoodParams;
+use crate::immpf::{Appearance, DetectionLikelihoodParams, FrameCues, HistogramScratch};
 
 /// σ of the velocities the proposal draws around the detections' velocity, as a multiple of
 /// `σ / elapsed` (σ the foot likelihood's, `elapsed` the frames between the two detections):
@@ -27,23 +29,34 @@ use crate::immpf::DetectionLikelihoodParams;
 const VELOCITY_PROPOSAL_SD: f64 = 0.2;
 
 impl PedestrianTracker {
-    /// One frame of the detections-only mode ([`PedestrianTracker::step`] without cues).
+    /// One frame of the detection-driven mode ([`PedestrianTracker::step`] without cues, or
+    /// with cues and detections as measurements).
     pub(super) fn step_on_detections(
         &mut self,
         frame: FrameIndex,
         candidates: &[Candidate],
+        cues: Option<&FrameCues>,
         out: &mut Vec<PedestrianEstimate>,
     ) {
         let models = &self.models;
         self.tracks
             .par_iter_mut()
             .for_each(|track| track.filter.predict(models));
-        let unmatched = self.match_in_two_stages(candidates);
-        self.correct_on_detections(frame);
+        let looks: Vec<Option<Appearance>> = match cues {
+            Some(cues) if self.params.detection.colour_weight > 0.0 => candidates
+                .par_iter()
+                .map(|c| Appearance::capture(&self.params.appearance, cues, &c.bbox))
+                .collect(),
+            _ => vec![None; candidates.len()],
+        };
+        let unmatched = self.match_in_two_stages(candidates, &looks);
+        self.correct_on_detections(frame, cues);
         self.end_lost_trackers();
-        for candidate in unmatched.into_iter().map(|d| candidates[d]) {
+        for d in unmatched {
+            let candidate = candidates[d];
             self.next_id += 1;
-            let mut track = self.spawn(self.next_id - 1, &candidate.bbox, None, 0);
+            let look = looks[d].clone();
+            let mut track = self.spawn(self.next_id - 1, &candidate.bbox, look, 0);
             track.matched = Some(candidate.bbox);
             track.hit_streak = 1;
             track.last_detection = Some((frame, candidate.bbox.foot()));
@@ -52,11 +65,16 @@ impl PedestrianTracker {
         self.report_on_detections(frame, out);
     }
 
-    /// Assigns `candidates` to the trackers (`Track::matched`): first those of score ≥
-    /// `high_score` to every tracker (IoU ≥ `match_iou`), then the others to the trackers
-    /// still free that a detection held in the previous frame (IoU ≥ `low_match_iou`).
-    /// Returns the indices of the confident candidates left, the births.
-    fn match_in_two_stages(&mut self, candidates: &[Candidate]) -> Vec<usize> {
+    /// Assigns `candidates` (their colour histograms `looks`, with frames) to the trackers
+    /// (`Track::matched`): first those of score ≥ `high_score` to every tracker (IoU ≥
+    /// `match_iou`), then the others to the trackers still free that a detection held in the
+    /// previous frame (IoU ≥ `low_match_iou`). Returns the indices of the confident
+    /// candidates left, the births.
+    fn match_in_two_stages(
+        &mut self,
+        candidates: &[Candidate],
+        looks: &[Option<Appearance>],
+    ) -> Vec<usize> {
         let params = &self.params.detection;
         let predicted: Vec<BoundingBox> = self
             .tracks
@@ -68,44 +86,60 @@ impl PedestrianTracker {
             (0..candidates.len()).partition(|&d| candidates[d].score >= params.high_score);
         let (match_iou, low_match_iou) = (params.match_iou, params.low_match_iou);
         let everyone: Vec<usize> = (0..self.tracks.len()).collect();
-        let (free, left) = self.assign_stage(&predicted, &everyone, candidates, &strong, match_iou);
+        let pool = Pool { candidates, looks };
+        let (free, left) = self.assign_stage(&predicted, &everyone, &pool, &strong, match_iou);
         let held_last: Vec<usize> = free
             .into_iter()
             .filter(|&t| self.tracks[t].unsupported_frames == 0)
             .collect();
-        self.assign_stage(&predicted, &held_last, candidates, &weak, low_match_iou);
+        self.assign_stage(&predicted, &held_last, &pool, &weak, low_match_iou);
         left
     }
 
     /// The Hungarian assignment of the candidates `dets` to the trackers `tracks` on
-    /// `1 − IoU` with their predicted boxes, pairs of IoU ≥ `min_iou` kept and recorded in
-    /// `Track::matched`. Returns the trackers and the candidates left.
+    /// `1 − IoU + w·d²` with their predicted boxes (`w` = `colour_weight`, d² the colour
+    /// distance of the detection to the tracker's reference, 0 without frames), pairs of
+    /// IoU ≥ `min_iou` kept and recorded in `Track::matched`. Returns the trackers and the
+    /// candidates left.
     fn assign_stage(
         &mut self,
         predicted: &[BoundingBox],
         tracks: &[usize],
-        candidates: &[Candidate],
+        pool: &Pool<'_>,
         dets: &[usize],
         min_iou: f64,
     ) -> (Vec<usize>, Vec<usize>) {
+        let weight = self.params.detection.colour_weight;
         let costs: Vec<f64> = tracks
             .iter()
             .flat_map(|&t| dets.iter().map(move |&d| (t, d)))
-            .map(|(t, d)| 1.0 - predicted[t].iou(&candidates[d].bbox))
+            .map(|(t, d)| {
+                let iou = predicted[t].iou(&pool.candidates[d].bbox);
+                if iou < min_iou {
+                    return f64::INFINITY;
+                }
+                let colour = match (&self.tracks[t].appearance, &pool.looks[d]) {
+                    (Some(reference), Some(look)) if weight > 0.0 => {
+                        weight * reference.colour_distance(look)
+                    }
+                    _ => 0.0,
+                };
+                1.0 - iou + colour
+            })
             .collect();
         let pairs = assign(
             &mut self.solver,
             tracks.len(),
             dets.len(),
             &costs,
-            1.0 - min_iou,
+            1.0 - min_iou + weight,
         );
         let mut track_taken = vec![false; tracks.len()];
         let mut det_taken = vec![false; dets.len()];
         for (r, c) in pairs {
             track_taken[r] = true;
             det_taken[c] = true;
-            self.tracks[tracks[r]].matched = Some(candidates[dets[c]].bbox);
+            self.tracks[tracks[r]].matched = Some(pool.candidates[dets[c]].bbox);
         }
         let tracks_left = (0..tracks.len()).filter(|&r| !track_taken[r]);
         let dets_left = (0..dets.len()).filter(|&c| !det_taken[c]);
@@ -119,12 +153,18 @@ impl PedestrianTracker {
     /// the foot-point distance (σ = `foot_sigma_fraction` × the detection's height) after a
     /// share `proposal_share` of them was drawn around that foot point
     /// ([`propose_on_detection`]); the others coast on their prediction. Counts matches in a
-    /// row and frames without one, and lets the box size follow the detections.
-    fn correct_on_detections(&mut self, frame: FrameIndex) {
+    /// row and frames without one, lets the box size follow the detections and, with frames
+    /// (`cues`), the colour reference follow the matched detection ([`Appearance::adapt`]).
+    fn correct_on_detections(&mut self, frame: FrameIndex, cues: Option<&FrameCues>) {
         let (params, sizing) = (&self.params.detection, &self.sizing);
-        self.tracks.par_iter_mut().for_each(|track| {
+        let appearance_params = &self.params.appearance;
+        let tracks = self.tracks.par_iter_mut();
+        tracks.for_each_init(HistogramScratch::default, |scratch, track| {
             match track.matched {
                 Some(detection) => {
+                    if let (Some(reference), Some(cues)) = (&mut track.appearance, cues) {
+                        reference.adapt(appearance_params, cues, &detection, scratch);
+                    }
                     let foot = detection.foot();
                     let sigma = (params.foot_sigma_fraction * detection.height_px).max(1.0);
                     propose_on_detection(track, foot, sigma, frame, params);
@@ -236,4 +276,10 @@ fn propose_on_detection(
         None => track.filter.propose_near(share, foot, sigma),
     }
     track.last_detection = Some((frame, foot));
+}
+
+/// The candidates of one frame with their colour histograms (`None` without frames).
+struct Pool<'a> {
+    candidates: &'a [Candidate],
+    looks: &'a [Option<Appearance>],
 }
