@@ -109,7 +109,7 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         args.detections.as_deref(),
         size,
         &settings.motion_params(args.ground_plane.is_some()),
-        &params.appearance,
+        params,
         &FrameOptions {
             max_frames: args.max_frames,
             ..FrameOptions::default()

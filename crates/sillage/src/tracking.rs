@@ -101,7 +101,7 @@ pub fn track_source(
                 setup.detections.as_deref(),
                 None,
                 &motion,
-                &setup.settings.tracker.appearance,
+                &setup.settings.tracker,
                 frames,
                 false,
             )?;

@@ -217,7 +217,7 @@ impl Sequence {
             (input.with_detections || !use_images).then_some(detections.as_path()),
             frame_size_beside(&detections),
             motion,
-            &params.appearance,
+            params,
             &FrameOptions {
                 max_frames: input.max_frames,
                 ..FrameOptions::default()

@@ -8,7 +8,9 @@ use std::path::Path;
 use sillage_core::{Error, FrameIndex, GrayImage, Result, RgbImage};
 use sillage_detect::motion::{MotionBlob, MotionDetector, MotionParams, blob_box};
 use sillage_io::{FrameOptions, FrameSource, open_frames, read_mot_rows};
-use sillage_track::immpf::{AppearanceParams, Candidate, FrameCues};
+use sillage_track::immpf::{
+    AppearanceParams, Candidate, DetectionsWithFrames, FrameCues, PedestrianParams,
+};
 
 use super::within;
 
@@ -32,6 +34,9 @@ pub struct PedestrianInput {
     detections: Option<BTreeMap<FrameIndex, Vec<Candidate>>>,
     motion: Option<MotionDetector>,
     appearance: AppearanceParams,
+    /// Whether the frames' colour and motion bins are computed: not when detections drive
+    /// the trackers without colour in the assignment, which then ignores them.
+    binned: bool,
     /// Spare buffers for the next frame's bins (see [`PedestrianInput::recycle`]).
     cues: FrameCues,
     /// The previous frame's grey levels, for the motion histogram.
@@ -99,16 +104,21 @@ impl PedestrianInput {
     /// Colour frames of `input` (motion blobs as candidates unless `detections` is given),
     /// or, without `input`, the detections alone over frames of `frame_size_px`; `frames`
     /// selects the frames (`start_at`, `stop_at`, `max_frames`; colour is always decoded);
-    /// `keep_colour` keeps each colour frame in [`PreparedFrame::colour`].
+    /// `keep_colour` keeps each colour frame in [`PreparedFrame::colour`]. `params` (the
+    /// tracker's) says what the frames are for: with detections as measurements
+    /// (`detection.with_frames`) no motion detector runs, and the frames are binned only
+    /// for a colour weight above 0.
     pub fn open(
         input: Option<&str>,
         detections: Option<&Path>,
         frame_size_px: Option<(usize, usize)>,
         motion: &MotionParams,
-        appearance: &AppearanceParams,
+        params: &PedestrianParams,
         frames: &FrameOptions,
         keep_colour: bool,
     ) -> Result<Self> {
+        let detections_drive = detections.is_some()
+            && params.detection.with_frames == DetectionsWithFrames::Measurements;
         let max_frames = frames.max_frames;
         let detections = detections.map(read_candidates).transpose()?;
         let (start, options) = (frames.start_at, frames);
@@ -144,14 +154,15 @@ impl PedestrianInput {
         // With frames, the motion detector gives the foreground mask of the likelihood, and
         // the birth candidates unless detections are given.
         let motion = match &frames {
-            Some(_) => Some(MotionDetector::new(motion, size.0, size.1)?),
-            None => None,
+            Some(_) if !detections_drive => Some(MotionDetector::new(motion, size.0, size.1)?),
+            _ => None,
         };
         Ok(Self {
             frames,
             detections,
             motion,
-            appearance: appearance.clone(),
+            appearance: params.appearance.clone(),
+            binned: !detections_drive || params.detection.colour_weight > 0.0,
             cues: FrameCues::default(),
             previous: None,
             keep_colour,
@@ -201,23 +212,28 @@ impl PedestrianInput {
             }
             None => None,
         };
-        // The buffers the consumer gave back (`recycle`), or new ones.
-        let mut cues = std::mem::take(&mut self.cues);
-        cues.update(
-            &self.appearance,
-            colour,
-            &frame.image,
-            self.previous.as_ref(),
-            foreground,
-        )
-        .map_err(context)?;
+        let cues = if self.binned {
+            // The buffers the consumer gave back (`recycle`), or new ones.
+            let mut cues = std::mem::take(&mut self.cues);
+            cues.update(
+                &self.appearance,
+                colour,
+                &frame.image,
+                self.previous.as_ref(),
+                foreground,
+            )
+            .map_err(context)?;
+            Some(cues)
+        } else {
+            None
+        };
         let candidates = match &self.detections {
             Some(_) => self.candidates_of(frame.index),
             None => blobs.iter().map(blob_candidate).collect(),
         };
         let prepared = PreparedFrame {
             frame: frame.index,
-            cues: Some(cues),
+            cues,
             candidates,
             candidates_are_detections: self.detections.is_some(),
             colour: if self.keep_colour {
