@@ -1,6 +1,7 @@
 //! `track immpf`: pedestrians with one IMM particle filter each (Madrigal & Hayet), on colour
-//! frames (motion blobs or detections as births) or on detections alone, streamed frame by
-//! frame to a callback; the rows of its MOTChallenge results and of its model-weights file.
+//! frames (motion blobs as births, or detections driving the trackers) or on detections
+//! alone, streamed frame by frame to a callback; the rows of its MOTChallenge results and of
+//! its model-weights file.
 
 use std::io::Write as _;
 use std::path::Path;

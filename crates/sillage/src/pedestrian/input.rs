@@ -1,6 +1,7 @@
 //! The inputs of the pedestrian tracker, frame by frame: colour frames binned for the
 //! observation model with their motion blobs as birth candidates, or MOTChallenge detections
-//! (as birth candidates beside the frames, or alone in the detections-only mode).
+//! (beside the frames, as measurements or as birth candidates, or alone in the
+//! detections-only mode).
 
 use std::collections::BTreeMap;
 use std::path::Path;
