@@ -1,14 +1,13 @@
 //! The detection-driven mode of the pedestrian tracker: the detections are both the births and
 //! the measurements, alone or with colour frames. Each person keeps its IMM particle filter
-//! (the competing motion models of the paper predict where its box goes); the detections are
-//! assigned to the predicted boxes by the Hungarian algorithm on IoU — with frames, IoU and
-//! the colour distance to the person's reference histograms (§4.3) — in two stages — the
-//! confident detections
-//! to every tracker, then the weak ones to the trackers that a detection held in the previous
-//! frame (ByteTrack's idea: a partly occluded person scores low) — and a tracker's life
-//! follows SORT and ByteTrack: confirmed after `min_hits` matches in a row (its earlier frames
-//! then reported too, with `report_first_hits`), only confident detections start trackers, a
-//! tentative tracker ends at its first miss, a confirmed one is kept
+//! (the competing motion models of the paper predict where its box goes). The detections are
+//! assigned to the predicted boxes by the Hungarian algorithm on IoU (with frames, optionally
+//! plus the colour distance to the person's reference histograms of §4.3) in two stages: the
+//! confident detections to every tracker, then the weak ones to the trackers that a detection
+//! held in the previous frame (ByteTrack's idea: a partly occluded person scores low). A
+//! tracker's life follows SORT and ByteTrack: confirmed after `min_hits` matches in a row (its
+//! earlier frames then reported too, with `report_first_hits`), only confident detections
+//! start trackers, a tentative tracker ends at its first miss, a confirmed one is kept
 //! `lost_frames` frames without a detection and may take one back, and a tracker is reported
 //! on the frames a detection holds it.
 
