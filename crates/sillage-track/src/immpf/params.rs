@@ -175,6 +175,16 @@ pub struct DetectionLikelihoodParams {
     pub colour_weight: f64,
 }
 
+impl DetectionLikelihoodParams {
+    /// Whether candidates drive the trackers as measurements (the detection-driven mode):
+    /// always without frames; with frames, when they are detections (not motion blobs) and
+    /// `with_frames` is `measurements`.
+    pub fn drive_trackers(&self, with_frames: bool, candidates_are_detections: bool) -> bool {
+        !with_frames
+            || candidates_are_detections && self.with_frames == DetectionsWithFrames::Measurements
+    }
+}
+
 impl Default for DetectionLikelihoodParams {
     fn default() -> Self {
         Self {

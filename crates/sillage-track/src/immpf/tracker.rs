@@ -19,7 +19,7 @@ use sillage_filter::{
 
 use super::appearance::{Appearance, FrameCues, HistogramScratch};
 use super::models::PedestrianMotion;
-use super::params::{DetectionsWithFrames, ModelName, PedestrianParams, REVIVAL_GATE_AT_DEATH};
+use super::params::{ModelName, PedestrianParams, REVIVAL_GATE_AT_DEATH};
 use super::sizing::BoxSizing;
 use sillage_core::BoundingBox;
 
@@ -234,10 +234,12 @@ impl PedestrianTracker {
             .filter(|c| c.bbox.is_valid() && c.score >= self.params.detection.min_score)
             .copied()
             .collect();
-        let detections_drive = frame.candidates_are_detections
-            && self.params.detection.with_frames == DetectionsWithFrames::Measurements;
+        let drive = self
+            .params
+            .detection
+            .drive_trackers(frame.cues.is_some(), frame.candidates_are_detections);
         let cues = match frame.cues {
-            Some(cues) if !detections_drive => cues,
+            Some(cues) if !drive => cues,
             cues => {
                 self.step_on_detections(frame.frame, &candidates, cues, out);
                 return Ok(());

@@ -9,9 +9,7 @@ use std::path::Path;
 use sillage_core::{Error, FrameIndex, GrayImage, Result, RgbImage};
 use sillage_detect::motion::{MotionBlob, MotionDetector, MotionParams, blob_box};
 use sillage_io::{FrameOptions, FrameSource, open_frames, read_mot_rows};
-use sillage_track::immpf::{
-    AppearanceParams, Candidate, DetectionsWithFrames, FrameCues, PedestrianParams,
-};
+use sillage_track::immpf::{AppearanceParams, Candidate, FrameCues, PedestrianParams};
 
 use super::within;
 
@@ -118,8 +116,8 @@ impl PedestrianInput {
         frames: &FrameOptions,
         keep_colour: bool,
     ) -> Result<Self> {
-        let detections_drive = detections.is_some()
-            && params.detection.with_frames == DetectionsWithFrames::Measurements;
+        let detections_drive =
+            input.is_some() && params.detection.drive_trackers(true, detections.is_some());
         let max_frames = frames.max_frames;
         let detections = detections.map(read_candidates).transpose()?;
         let (start, options) = (frames.start_at, frames);
