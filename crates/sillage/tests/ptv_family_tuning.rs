@@ -5,9 +5,11 @@
 //! Ignored (a few minutes in release mode):
 //! `cargo test --release -p sillage --test ptv_family_tuning -- --ignored --nocapture`.
 //!
-//! `AUTO_VOTE_MIN_VALID_SHARE` and `AUTO_VOTE_FIRST_LINK_SPACINGS` are constants of the
-//! tracker, not configuration keys: they were tuned by editing them and running
-//! `sillage bench ptv-accuracy --family moderate --half tune --no-search`.
+//! `AUTO_VOTE_MIN_VALID_SHARE` and `AUTO_VOTE_FIRST_LINK_SPACINGS` (tracker) and
+//! `FLAT_PEAK_SIGMAS` (the matched-scale re-fit, `sillage_detect::matched_refine`) are
+//! constants, not configuration keys: they were tuned by editing them and running
+//! `sillage bench ptv-accuracy --family moderate --half tune --no-search` (the last one also
+//! with `--family main`).
 
 use sillage::DetectorConfig;
 use sillage::PipelineConfig;
