@@ -319,17 +319,18 @@ impl MatchedRefiner {
 /// image) along the two axes and, halved for their √2 step, the two diagonals: how sharp the
 /// peak is in its flattest direction. A single Gaussian particle gives the same in every
 /// direction; two that overlap give a flat ridge along the line joining them. `None` when a
-/// value is not positive.
+/// value is not positive. (One logarithm: `2 ln c − ln a − ln b = ln(c² / ab)`, and the least
+/// of the logarithms is the logarithm of the least ratio.)
 fn sharpness(image: &GrayImage, x: usize, y: usize) -> Option<f64> {
-    let ln = |dx: isize, dy: isize| {
+    let at = |dx: isize, dy: isize| {
         let v = f64::from(image.get((x as isize + dx) as usize, (y as isize + dy) as usize));
-        (v > 0.0).then(|| v.ln())
+        (v > 0.0).then_some(v)
     };
-    let centre = 2.0 * ln(0, 0)?;
-    let along = |dx: isize, dy: isize| Some(centre - ln(-dx, -dy)? - ln(dx, dy)?);
-    let axes = along(1, 0)?.min(along(0, 1)?);
-    let diagonals = along(1, 1)?.min(along(1, -1)?);
-    Some(axes.min(0.5 * diagonals))
+    let centre_sq = at(0, 0)?.powi(2);
+    let ratio = |dx: isize, dy: isize| Some(centre_sq / (at(-dx, -dy)? * at(dx, dy)?));
+    let axes = ratio(1, 0)?.min(ratio(0, 1)?);
+    let diagonals = ratio(1, 1)?.min(ratio(1, -1)?);
+    Some(axes.min(diagonals.sqrt()).ln())
 }
 
 /// The median of `values` (reordered), `None` when empty.
