@@ -15,7 +15,9 @@
 
 use rayon::prelude::*;
 use sillage_core::{Detection, GrayImage, Point2, Result};
-use sillage_image::{DogFilter, Peak, PeakFinder, Polarity, SubpixelFit, refine_peak};
+use sillage_image::{
+    DogFilter, Peak, PeakFinder, Polarity, SubpixelFit, median_mad_of, refine_peak,
+};
 
 /// A detection is isolated when no other lies within this many particle σ.
 pub const ISOLATION_SIGMAS: f64 = 4.0;
@@ -37,8 +39,6 @@ pub const MERGE_SIGMAS: f64 = 2.0;
 /// within 2 points of tuned, 6 → 11 with ≤ 2 % false, mean 69.3 / 11.4 → 69.9 / 10.7 %, no
 /// case losing true recoveries.
 pub const FLAT_PEAK_SIGMAS: f64 = 3.0;
-/// The median absolute deviation of a normal sample times this is its standard deviation.
-const MAD_TO_SIGMA: f64 = 1.4826;
 /// Farthest a 3-point sub-pixel fit moves a peak from its pixel (half a pixel per axis,
 /// `√0.5` px), with a margin for rounding.
 const FIT_SHIFT_BOUND_PX: f64 = 0.75;
@@ -60,8 +60,8 @@ pub(crate) struct MatchedRefiner {
     isolated: Vec<bool>,
     /// Each detection's re-fit on the matched image and that peak's sharpness (reused).
     refits: Vec<Option<(Point2, f64)>>,
-    /// The sharpness values, for their median (reused).
-    sharpness: Vec<f64>,
+    /// The sharpness values, for their median and spread (reused).
+    sharpness: Vec<f32>,
     /// The completion's candidates, in peak order (reused).
     added: Vec<Option<Detection>>,
     grid: (usize, usize),
@@ -167,14 +167,14 @@ impl MatchedRefiner {
             })
             .collect_into_vec(&mut refits);
         self.sharpness.clear();
-        self.sharpness
-            .extend(refits.iter().flatten().map(|&(_, sharpness)| sharpness));
-        if let Some(centre) = median(&mut self.sharpness) {
-            self.sharpness
-                .iter_mut()
-                .for_each(|v| *v = (*v - centre).abs());
-            let spread = MAD_TO_SIGMA * median(&mut self.sharpness).unwrap_or(0.0);
-            let floor = centre - FLAT_PEAK_SIGMAS * spread;
+        self.sharpness.extend(
+            refits
+                .iter()
+                .flatten()
+                .map(|&(_, sharpness)| sharpness as f32),
+        );
+        if let Some(stats) = median_mad_of(&mut self.sharpness) {
+            let floor = stats.median - FLAT_PEAK_SIGMAS * stats.sigma;
             for (detection, refit) in detections.iter_mut().zip(&refits) {
                 if let Some((pos_px, sharpness)) = *refit
                     && sharpness >= floor
@@ -331,15 +331,6 @@ fn sharpness(image: &GrayImage, x: usize, y: usize) -> Option<f64> {
     let axes = ratio(1, 0)?.min(ratio(0, 1)?);
     let diagonals = ratio(1, 1)?.min(ratio(1, -1)?);
     Some(axes.min(diagonals.sqrt()).ln())
-}
-
-/// The median of `values` (reordered), `None` when empty.
-fn median(values: &mut [f64]) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    let mid = values.len() / 2;
-    Some(*values.select_nth_unstable_by(mid, f64::total_cmp).1)
 }
 
 #[cfg(test)]

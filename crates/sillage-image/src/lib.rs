@@ -83,6 +83,6 @@ pub use morphology::Morphology;
 pub use ncc::{MAX_TEMPLATE_RADIUS_PX, RingCorrelator, RingTemplate};
 pub use reconstruct::Reconstruction;
 pub use sift::{SiftDescriptor, SiftDetector, SiftKeypoint, SiftParams};
-pub use stats::{MeanStd, MedianMad, mean_std, median_mad};
+pub use stats::{MeanStd, MedianMad, mean_std, median_mad, median_mad_of};
 pub use structuring::{MAX_ELEMENT_RADIUS_PX, StructuringElement};
 pub use subpixel::{SubpixelFit, parabola_offset, refine_peak};

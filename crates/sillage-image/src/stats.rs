@@ -115,11 +115,21 @@ pub fn median_mad(image: &GrayImage, samples: &mut Vec<f32>) -> Option<MedianMad
                 *o = v;
             }
         });
-    let median = f64::from(median_of(samples));
-    for v in samples.iter_mut() {
+    median_mad_of(samples)
+}
+
+/// Median and `1.4826 · MAD` of `values` (reordered, then overwritten by their absolute
+/// deviations from the median), or `None` when there are none: two `select_nth_unstable`
+/// passes.
+pub fn median_mad_of(values: &mut [f32]) -> Option<MedianMad> {
+    if values.is_empty() {
+        return None;
+    }
+    let median = f64::from(median_of(values));
+    for v in values.iter_mut() {
         *v = (f64::from(*v) - median).abs() as f32;
     }
-    let mad = f64::from(median_of(samples));
+    let mad = f64::from(median_of(values));
     Some(MedianMad {
         median,
         sigma: MAD_TO_SIGMA * mad,
