@@ -45,10 +45,11 @@ fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
     common::synth_vortex(&frames, 12, 800, (512, 512), &[]);
     // Changed on purpose: the blob scale and polarity are measured from the frames by
     // default (issue "PTV that needs no hand tuning"; they were fixed at 2 px, bright), and
-    // the automatic scale became √(0.7σ̂) instead of √(0.8σ̂) (2026-11-28).
+    // the automatic scale became √(0.7σ̂) instead of √(0.8σ̂) (2026-11-28), and the
+    // matched-scale re-fit is refused on flat peaks (`FLAT_PEAK_SIGMAS`, 2026-11-28).
     let expected = [
-        ("tracks_track.txt", 0x31eb_32ef_bf3d_a38c_u64),
-        ("tracks.csv", 0xd347_38b6_2e65_e8a4),
+        ("tracks_track.txt", 0x01c9_0f1a_63cc_363d_u64),
+        ("tracks.csv", 0x4d94_b61a_64d6_5e1d),
     ];
     for (name, hash) in expected {
         let out = dir.path().join(name);
