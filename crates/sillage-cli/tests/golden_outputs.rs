@@ -46,10 +46,11 @@ fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
     // Changed on purpose: the blob scale and polarity are measured from the frames by
     // default (issue "PTV that needs no hand tuning"; they were fixed at 2 px, bright), and
     // the automatic scale became √(0.7σ̂) instead of √(0.8σ̂) (2026-11-28), and the
-    // matched-scale re-fit is refused on flat peaks (`FLAT_PEAK_SIGMAS`, 2026-11-28).
+    // matched-scale re-fit is refused on flat peaks (`FLAT_PEAK_SIGMAS`, 2026-11-28), and
+    // later that day twins of one particle were merged and the scale became √(0.5σ̂).
     let expected = [
-        ("tracks_track.txt", 0x01c9_0f1a_63cc_363d_u64),
-        ("tracks.csv", 0x4d94_b61a_64d6_5e1d),
+        ("tracks_track.txt", 0x0245_fdea_4cea_d619_u64),
+        ("tracks.csv", 0xe998_30c5_72d5_d3d0),
     ];
     for (name, hash) in expected {
         let out = dir.path().join(name);

@@ -11,7 +11,10 @@
 //! particles keep the resolving scale's position, since the matched filter pulls neighbours
 //! together; so does an "isolated" one whose matched peak is flatter in some direction than a
 //! single particle's ([`FLAT_PEAK_SIGMAS`]): a second particle overlaps it that the
-//! resolving scale did not separate, and the matched peak lies between the two.
+//! resolving scale did not separate, and the matched peak lies between the two. Detections
+//! within [`MERGE_SIGMAS`] σ of each other that climb to one round matched peak, with no other
+//! detection near, are twins (noise splits a large particle's peak at the small resolving
+//! scale): they become one detection, re-fitted.
 
 use rayon::prelude::*;
 use sillage_core::{Detection, GrayImage, Point2, Result};
@@ -47,19 +50,38 @@ const PAR_MIN_LEN: usize = 512;
 /// Steps of the climb from a detection to the matched image's local maximum.
 const MAX_CLIMB_STEPS: usize = 3;
 
+/// Where a detection's climb on the matched image ended.
+#[derive(Debug, Clone, Copy)]
+struct Climb {
+    /// The local maximum reached, pixel.
+    peak: (u32, u32),
+    /// Its sub-pixel fit.
+    pos_px: Point2,
+    /// Its [`sharpness`].
+    sharpness: f64,
+}
+
 /// The matched-scale filter and its buffers.
 #[derive(Debug, Clone)]
 pub(crate) struct MatchedRefiner {
     dog: DogFilter,
     matched: GrayImage,
+    /// The particle images' std σ, px.
+    sigma_px: f64,
     isolation_px: f64,
     finder: PeakFinder,
     peaks: Vec<Peak>,
     cell_start: Vec<u32>,
     cell_members: Vec<u32>,
-    isolated: Vec<bool>,
-    /// Each detection's re-fit on the matched image and that peak's sharpness (reused).
-    refits: Vec<Option<(Point2, f64)>>,
+    /// Whether each detection's neighbours within the isolation radius all lie within the
+    /// merge radius (possible twins from one particle), so that it is climbed.
+    candidate: Vec<bool>,
+    /// Each candidate detection's climb on the matched image (reused).
+    climbs: Vec<Option<Climb>>,
+    /// Candidates grouped by the matched peak they reach (reused).
+    order: Vec<u32>,
+    /// Detections found to be a second detection of a particle, removed after the look.
+    twins: Vec<bool>,
     /// The sharpness values, for their median and spread (reused).
     sharpness: Vec<f32>,
     /// The completion's candidates, in peak order (reused).
@@ -73,13 +95,16 @@ impl MatchedRefiner {
         Ok(Self {
             dog: DogFilter::new(sigma_px)?,
             matched: GrayImage::default(),
+            sigma_px,
             isolation_px: ISOLATION_SIGMAS * sigma_px,
             finder: PeakFinder::default(),
             peaks: Vec::new(),
             cell_start: Vec::new(),
             cell_members: Vec::new(),
-            isolated: Vec::new(),
-            refits: Vec::new(),
+            candidate: Vec::new(),
+            climbs: Vec::new(),
+            order: Vec::new(),
+            twins: Vec::new(),
             sharpness: Vec::new(),
             added: Vec::new(),
             grid: (1, 1),
@@ -100,14 +125,29 @@ impl MatchedRefiner {
         detections: &mut Vec<Detection>,
     ) {
         self.dog.apply(input, polarity, &mut self.matched);
-        self.mark_isolated(input.dimensions(), offset, detections);
+        self.added.clear();
+        self.mark_candidates(input.dimensions(), offset, detections);
         self.refit_isolated(fit, offset, detections);
-        let Some(threshold) = threshold(&self.matched) else {
-            return;
-        };
+        if let Some(threshold) = threshold(&self.matched) {
+            self.complete(threshold, fit, offset, detections);
+        }
+        let mut twins = self.twins.iter();
+        detections.retain(|_| !twins.next().copied().unwrap_or(false));
+        detections.extend(self.added.iter().flatten());
+    }
+
+    /// Finds the matched image's peaks above `threshold` that no detection is near (faint
+    /// particles the resolving scale missed), into `self.added`.
+    fn complete(
+        &mut self,
+        threshold: f32,
+        fit: SubpixelFit,
+        offset: (f64, f64),
+        detections: &[Detection],
+    ) {
         self.finder
             .find(&self.matched, 1, threshold, &mut self.peaks);
-        let merge_px = MERGE_SIGMAS / ISOLATION_SIGMAS * self.isolation_px;
+        let merge_px = MERGE_SIGMAS * self.sigma_px;
         let merge2 = merge_px.powi(2);
         // Half a pixel on each axis is 0.7071 px; the margin also covers rounding.
         let merge_sure2 = (merge_px - FIT_SHIFT_BOUND_PX).max(0.0).powi(2);
@@ -132,63 +172,110 @@ impl MatchedRefiner {
                     .then(|| Detection::new(p, this.matched.get(peak.x, peak.y)))
             })
             .collect_into_vec(&mut added);
-        detections.extend(added.iter().flatten());
         self.added = added;
     }
 
-    /// Moves each isolated detection to its re-fit on the matched image, unless the fit is more
-    /// than σ away or its peak is flatter than a single particle's.
+    /// Moves each isolated particle's detection to its re-fit on the matched image, unless the
+    /// fit is more than σ away or its peak is flatter than a single particle's. A particle is
+    /// isolated when every detection within the isolation radius climbs to the same matched
+    /// peak: noise can split a large particle's peak at the resolving scale, and the twins
+    /// then become one detection (the first), the others marked in `self.twins`.
     fn refit_isolated(
         &mut self,
         fit: SubpixelFit,
         offset: (f64, f64),
         detections: &mut [Detection],
     ) {
-        let max_shift = self.isolation_px / ISOLATION_SIGMAS;
-        let mut refits = std::mem::take(&mut self.refits);
+        let max_shift = self.sigma_px;
+        let r2 = self.isolation_px.powi(2);
+        let mut climbs = std::mem::take(&mut self.climbs);
         let this = &*self;
         detections
             .par_iter()
-            .zip(this.isolated.par_iter())
+            .zip(this.candidate.par_iter())
             .with_min_len(PAR_MIN_LEN)
-            .map(|(detection, &isolated)| {
-                if !isolated {
+            .map(|(detection, &candidate)| {
+                if !candidate {
                     return None;
                 }
                 let local =
                     Point2::new(detection.pos_px.x - offset.0, detection.pos_px.y - offset.1);
-                let (refined, sharpness) = this.fit_near(local, fit)?;
-                (refined.distance(local) < max_shift).then(|| {
-                    (
-                        Point2::new(refined.x + offset.0, refined.y + offset.1),
-                        sharpness,
-                    )
+                this.climb(local, fit).map(|climb| Climb {
+                    pos_px: Point2::new(climb.pos_px.x + offset.0, climb.pos_px.y + offset.1),
+                    ..climb
                 })
             })
-            .collect_into_vec(&mut refits);
+            .collect_into_vec(&mut climbs);
+        // A climbed detection is isolated when every other within the radius reached its peak.
+        let isolated: Vec<bool> = (0..detections.len())
+            .into_par_iter()
+            .with_min_len(PAR_MIN_LEN)
+            .map(|i| {
+                let Some(own) = climbs[i] else {
+                    return false;
+                };
+                let p = detections[i].pos_px;
+                !this.any_neighbour(p, offset, |j| {
+                    j != i && {
+                        let q = detections[j].pos_px;
+                        (q.x - p.x).powi(2) + (q.y - p.y).powi(2) < r2
+                            && climbs[j].map(|c| c.peak) != Some(own.peak)
+                    }
+                })
+            })
+            .collect();
+        // Groups of detections that reached one peak, each in detection order.
+        let mut order = std::mem::take(&mut self.order);
+        order.clear();
+        order.extend((0..detections.len() as u32).filter(|&i| climbs[i as usize].is_some()));
+        order.sort_unstable_by_key(|&i| (climbs[i as usize].map(|c| c.peak), i));
+        let same_peak = |a: &u32, b: &u32| {
+            climbs[*a as usize].map(|c| c.peak) == climbs[*b as usize].map(|c| c.peak)
+        };
+        let groups: Vec<&[u32]> = order
+            .chunk_by(same_peak)
+            .filter(|group| group.iter().all(|&i| isolated[i as usize]))
+            .filter(|group| {
+                let refit = climbs[group[0] as usize].map(|c| c.pos_px);
+                refit.is_some_and(|refit| {
+                    group
+                        .iter()
+                        .any(|&i| detections[i as usize].pos_px.distance(refit) < max_shift)
+                })
+            })
+            .collect();
         self.sharpness.clear();
         self.sharpness.extend(
-            refits
+            groups
                 .iter()
-                .flatten()
-                .map(|&(_, sharpness)| sharpness as f32),
+                .filter_map(|group| climbs[group[0] as usize])
+                .map(|climb| climb.sharpness as f32)
+                .filter(|sharpness| sharpness.is_finite()),
         );
+        self.twins.clear();
+        self.twins.resize(detections.len(), false);
         if let Some(stats) = median_mad_of(&mut self.sharpness) {
             let floor = stats.median - FLAT_PEAK_SIGMAS * stats.sigma;
-            for (detection, refit) in detections.iter_mut().zip(&refits) {
-                if let Some((pos_px, sharpness)) = *refit
-                    && sharpness >= floor
-                {
-                    detection.pos_px = pos_px;
+            for group in &groups {
+                let Some(climb) = climbs[group[0] as usize] else {
+                    continue;
+                };
+                if climb.sharpness >= floor {
+                    detections[group[0] as usize].pos_px = climb.pos_px;
+                    for &twin in &group[1..] {
+                        self.twins[twin as usize] = true;
+                    }
                 }
             }
         }
-        self.refits = refits;
+        self.climbs = climbs;
+        self.order = order;
     }
 
-    /// Sets `self.isolated`: whether each detection has no other within the isolation radius
-    /// (a grid of cells as wide as the radius, counting-sorted).
-    fn mark_isolated(
+    /// Sets `self.candidate`: whether each detection's neighbours within the isolation radius
+    /// (a grid of cells as wide as the radius, counting-sorted) all lie within the merge radius
+    /// — none, or possible twins.
+    fn mark_candidates(
         &mut self,
         (width, height): (usize, usize),
         offset: (f64, f64),
@@ -221,7 +308,8 @@ impl MatchedRefiner {
         self.cell_start.copy_within(0..cols * rows, 1);
         self.cell_start[0] = 0;
         let r2 = r * r;
-        let mut isolated = std::mem::take(&mut self.isolated);
+        let twin2 = (MERGE_SIGMAS * self.sigma_px).powi(2);
+        let mut candidate = std::mem::take(&mut self.candidate);
         let this = &*self;
         detections
             .par_iter()
@@ -231,12 +319,13 @@ impl MatchedRefiner {
                 !this.any_neighbour(d.pos_px, offset, |j| {
                     j != i && {
                         let q = detections[j].pos_px;
-                        (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2) < r2
+                        let d2 = (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2);
+                        d2 < r2 && d2 >= twin2
                     }
                 })
             })
-            .collect_into_vec(&mut isolated);
-        self.isolated = isolated;
+            .collect_into_vec(&mut candidate);
+        self.candidate = candidate;
     }
 
     /// The grid cell of position `p` (with `offset`).
@@ -284,9 +373,9 @@ impl MatchedRefiner {
         })
     }
 
-    /// The sub-pixel peak of the matched image nearest `p` (a climb to its local maximum,
-    /// then the 3-point fit there) with that peak's [`sharpness`].
-    fn fit_near(&self, p: Point2, fit: SubpixelFit) -> Option<(Point2, f64)> {
+    /// The climb from `p` to the matched image's local maximum, with the 3-point fit there
+    /// and that peak's [`sharpness`] (positions in the matched image's pixels).
+    fn climb(&self, p: Point2, fit: SubpixelFit) -> Option<Climb> {
         let (width, height) = self.matched.dimensions();
         if width < 3 || height < 3 {
             return None;
@@ -308,28 +397,42 @@ impl MatchedRefiner {
             }
             (x, y) = (best.0, best.1);
         }
-        Some((
-            refine_peak(&self.matched, x, y, fit)?,
-            sharpness(&self.matched, x, y)?,
-        ))
+        Some(Climb {
+            peak: (x as u32, y as u32),
+            pos_px: refine_peak(&self.matched, x, y, fit)?,
+            sharpness: sharpness(&self.matched, x, y)?,
+        })
     }
 }
 
 /// The least second difference of `ln(value)` through pixel `(x, y)` (one pixel inside the
 /// image) along the two axes and, halved for their √2 step, the two diagonals: how sharp the
 /// peak is in its flattest direction. A single Gaussian particle gives the same in every
-/// direction; two that overlap give a flat ridge along the line joining them. `None` when a
-/// value is not positive. (One logarithm: `2 ln c − ln a − ln b = ln(c² / ab)`, and the least
+/// direction; two that overlap give a flat ridge along the line joining them. A direction
+/// whose neighbours are not both positive does not count (a narrow peak falls below zero
+/// within a pixel there); +∞ when none counts, `None` when the centre is not positive. (One logarithm: `2 ln c − ln a − ln b = ln(c² / ab)`, and the least
 /// of the logarithms is the logarithm of the least ratio.)
 fn sharpness(image: &GrayImage, x: usize, y: usize) -> Option<f64> {
     let at = |dx: isize, dy: isize| {
-        let v = f64::from(image.get((x as isize + dx) as usize, (y as isize + dy) as usize));
-        (v > 0.0).then_some(v)
+        f64::from(image.get((x as isize + dx) as usize, (y as isize + dy) as usize))
     };
-    let centre_sq = at(0, 0)?.powi(2);
-    let ratio = |dx: isize, dy: isize| Some(centre_sq / (at(-dx, -dy)? * at(dx, dy)?));
-    let axes = ratio(1, 0)?.min(ratio(0, 1)?);
-    let diagonals = ratio(1, 1)?.min(ratio(1, -1)?);
+    let centre = at(0, 0);
+    if centre <= 0.0 {
+        return None;
+    }
+    let centre_sq = centre * centre;
+    // A direction whose neighbours are not both positive falls off faster than any
+    // log-curvature measures: it is not the flat one.
+    let ratio = |dx: isize, dy: isize| {
+        let (a, b) = (at(-dx, -dy), at(dx, dy));
+        if a > 0.0 && b > 0.0 {
+            centre_sq / (a * b)
+        } else {
+            f64::INFINITY
+        }
+    };
+    let axes = ratio(1, 0).min(ratio(0, 1));
+    let diagonals = ratio(1, 1).min(ratio(1, -1));
     Some(axes.min(diagonals.sqrt()).ln())
 }
 
@@ -413,5 +516,73 @@ mod tests {
             .count();
         assert!(moved_home >= 45, "{moved_home} of 48 singles re-fitted");
         assert_eq!(detections[pair].pos_px, first, "the pair's detection moved");
+    }
+
+    /// 48 isolated particles on a 32-px grid; particle `twin_site` carries two detections
+    /// 1.5 px either side of it (a peak split by noise), particle `pair_site` a second particle
+    /// 3.5 px away (within the twin radius: only the flat-peak test keeps them two), each with
+    /// its own detection.
+    fn twin_and_pair_scene() -> (Vec<Point2>, Vec<Detection>, GrayImage, usize, usize) {
+        let (twin_site, pair_site) = (2 * 7 + 2, 5 * 7 + 4);
+        let mut spots = Vec::new();
+        let mut detections = Vec::new();
+        for gy in 1..8 {
+            for gx in 1..8 {
+                let p = Point2::new(32.0 * gx as f64 + 0.1 * gy as f64, 32.0 * gy as f64 + 0.2);
+                spots.push((p, 0.5, SIGMA_PX));
+                detections.push(Detection::new(Point2::new(p.x + 0.3, p.y - 0.2), 1.0));
+            }
+        }
+        let twin = spots[twin_site].0;
+        detections[twin_site] = Detection::new(Point2::new(twin.x - 1.5, twin.y + 0.2), 1.0);
+        detections.push(Detection::new(Point2::new(twin.x + 1.5, twin.y - 0.1), 1.0));
+        let partner = Point2::new(spots[pair_site].0.x + 3.5, spots[pair_site].0.y);
+        spots.push((partner, 0.5, SIGMA_PX));
+        detections.push(Detection::new(partner, 1.0));
+        let truth = spots.iter().map(|s| s.0).collect();
+        (truth, detections, image(&spots), twin_site, pair_site)
+    }
+
+    #[test]
+    fn twins_of_one_particle_become_one_refitted_detection_and_a_pair_stays_two() {
+        let (truth, mut detections, frame, twin_site, pair_site) = twin_and_pair_scene();
+        let before = detections.len();
+        let pair_first = detections[pair_site].pos_px;
+        let mut refiner = MatchedRefiner::new(SIGMA_PX).unwrap();
+        refiner.refine(
+            &frame,
+            Polarity::Bright,
+            SubpixelFit::Gaussian,
+            (0.0, 0.0),
+            |_| None,
+            &mut detections,
+        );
+        assert_eq!(detections.len(), before - 1, "exactly one twin removed");
+        let near = |p: Point2, r: f64| {
+            detections
+                .iter()
+                .filter(|d| d.pos_px.distance(p) < r)
+                .count()
+        };
+        assert_eq!(
+            near(truth[twin_site], 3.0),
+            1,
+            "one detection left on the split particle"
+        );
+        assert!(
+            detections[twin_site].pos_px.distance(truth[twin_site]) < 0.1,
+            "the twin re-fitted: {:?} vs {:?}",
+            detections[twin_site].pos_px,
+            truth[twin_site]
+        );
+        assert_eq!(
+            near(truth[pair_site], 5.0),
+            2,
+            "the pair keeps both detections"
+        );
+        assert_eq!(
+            detections[pair_site].pos_px, pair_first,
+            "the pair is not re-fitted"
+        );
     }
 }
