@@ -270,7 +270,7 @@ impl MatchedRefiner {
         self.twins.resize(detections.len(), false);
         if let Some(stats) = median_mad_of(&mut self.sharpness) {
             let floor = (stats.median - FLAT_PEAK_SIGMAS * stats.sigma)
-                .min(f64::from(stats.median) * self.round_share);
+                .min(stats.median * self.round_share);
             for group in &groups {
                 let Some(climb) = climbs[group[0] as usize] else {
                     continue;

@@ -9,7 +9,9 @@
 //! `FLAT_PEAK_SIGMAS` (the matched-scale re-fit, `sillage_detect::matched_refine`) are
 //! constants, not configuration keys: they were tuned by editing them and running
 //! `sillage bench ptv-accuracy --family moderate --half tune --no-search` (the last one also
-//! with `--family main`).
+//! with `--family main`). `AUTO_SCALE_BASE_PX` was first chosen here (δ explicit, without the
+//! matched-scale second look), then again by editing the constant with the second look as it
+//! runs (twins merged), on both families' tune halves the same way.
 
 use sillage::DetectorConfig;
 use sillage::PipelineConfig;
