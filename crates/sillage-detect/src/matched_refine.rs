@@ -544,6 +544,19 @@ mod tests {
         assert!(ridge < 0.75 * round, "pair {ridge} vs single {round}");
     }
 
+    /// The re-fits of `detections` on `frame`, at σ = `SIGMA_PX`, adding no faint particles.
+    fn refine_without_completion(frame: &GrayImage, detections: &mut Vec<Detection>) {
+        let mut refiner = MatchedRefiner::new(SIGMA_PX).unwrap();
+        refiner.refine(
+            frame,
+            Polarity::Bright,
+            SubpixelFit::Gaussian,
+            (0.0, 0.0),
+            |_| None,
+            detections,
+        );
+    }
+
     #[test]
     fn an_unresolved_pair_keeps_its_first_position() {
         // Isolated particles on a 32-px grid, their detections 0.4 px off; one site holds a
@@ -562,15 +575,7 @@ mod tests {
         spots.push((Point2::new(first.x + 3.0, first.y), 0.45, SIGMA_PX));
         detections[pair] = Detection::new(first, 1.0);
         let frame = image(&spots);
-        let mut refiner = MatchedRefiner::new(SIGMA_PX).unwrap();
-        refiner.refine(
-            &frame,
-            Polarity::Bright,
-            SubpixelFit::Gaussian,
-            (0.0, 0.0),
-            |_| None,
-            &mut detections,
-        );
+        refine_without_completion(&frame, &mut detections);
         let moved_home = (0..spots.len() - 1)
             .filter(|&k| k != pair)
             .filter(|&k| detections[k].pos_px.distance(spots[k].0) < 0.1)
@@ -609,15 +614,7 @@ mod tests {
         let (truth, mut detections, frame, twin_site, pair_site) = twin_and_pair_scene();
         let before = detections.len();
         let pair_first = detections[pair_site].pos_px;
-        let mut refiner = MatchedRefiner::new(SIGMA_PX).unwrap();
-        refiner.refine(
-            &frame,
-            Polarity::Bright,
-            SubpixelFit::Gaussian,
-            (0.0, 0.0),
-            |_| None,
-            &mut detections,
-        );
+        refine_without_completion(&frame, &mut detections);
         assert_eq!(detections.len(), before - 1, "exactly one twin removed");
         let near = |p: Point2, r: f64| {
             detections
