@@ -89,8 +89,13 @@ pub(crate) struct MatchedRefiner {
     candidate: Vec<bool>,
     /// Each candidate detection's climb on the matched image (reused).
     climbs: Vec<Option<Climb>>,
-    /// Candidates grouped by the matched peak they reach (reused).
+    /// Whether each climbed detection is isolated: every other within the isolation radius
+    /// reached its peak (reused).
+    isolated: Vec<bool>,
+    /// Climbed detections grouped by the matched peak they reach (reused).
     order: Vec<u32>,
+    /// The groups to re-fit, as ranges of `order` (reused).
+    groups: Vec<std::ops::Range<usize>>,
     /// Detections found to be a second detection of a particle, removed after the look.
     twins: Vec<bool>,
     /// The sharpness values, for their median and spread (reused).
@@ -117,7 +122,9 @@ impl MatchedRefiner {
             cell_members: Vec::new(),
             candidate: Vec::new(),
             climbs: Vec::new(),
+            isolated: Vec::new(),
             order: Vec::new(),
+            groups: Vec::new(),
             twins: Vec::new(),
             sharpness: Vec::new(),
             added: Vec::new(),
@@ -203,6 +210,9 @@ impl MatchedRefiner {
         let max_shift = self.sigma_px;
         let r2 = self.isolation_px.powi(2);
         let mut climbs = std::mem::take(&mut self.climbs);
+        let mut isolated = std::mem::take(&mut self.isolated);
+        let mut order = std::mem::take(&mut self.order);
+        let mut groups = std::mem::take(&mut self.groups);
         let this = &*self;
         detections
             .par_iter()
@@ -221,7 +231,7 @@ impl MatchedRefiner {
             })
             .collect_into_vec(&mut climbs);
         // A climbed detection is isolated when every other within the radius reached its peak.
-        let isolated: Vec<bool> = (0..detections.len())
+        (0..detections.len())
             .into_par_iter()
             .with_min_len(PAR_MIN_LEN)
             .map(|i| {
@@ -237,32 +247,33 @@ impl MatchedRefiner {
                     }
                 })
             })
-            .collect();
-        // Groups of detections that reached one peak, each in detection order.
-        let mut order = std::mem::take(&mut self.order);
+            .collect_into_vec(&mut isolated);
+        // Groups of detections that reached one peak, each in detection order; a group is
+        // re-fitted when all its members are isolated and one lies within σ of the fit.
+        let peak_of = |i: u32| climbs[i as usize].map(|c| c.peak);
         order.clear();
         order.extend((0..detections.len() as u32).filter(|&i| climbs[i as usize].is_some()));
-        order.sort_unstable_by_key(|&i| (climbs[i as usize].map(|c| c.peak), i));
-        let same_peak = |a: &u32, b: &u32| {
-            climbs[*a as usize].map(|c| c.peak) == climbs[*b as usize].map(|c| c.peak)
-        };
-        let groups: Vec<&[u32]> = order
-            .chunk_by(same_peak)
-            .filter(|group| group.iter().all(|&i| isolated[i as usize]))
-            .filter(|group| {
-                let refit = climbs[group[0] as usize].map(|c| c.pos_px);
-                refit.is_some_and(|refit| {
-                    group
-                        .iter()
-                        .any(|&i| detections[i as usize].pos_px.distance(refit) < max_shift)
-                })
-            })
-            .collect();
+        order.sort_unstable_by_key(|&i| (peak_of(i), i));
+        groups.clear();
+        let mut start = 0;
+        for group in order.chunk_by(|&a, &b| peak_of(a) == peak_of(b)) {
+            let range = start..start + group.len();
+            start = range.end;
+            let near_fit = climbs[group[0] as usize].is_some_and(|climb| {
+                group
+                    .iter()
+                    .any(|&i| detections[i as usize].pos_px.distance(climb.pos_px) < max_shift)
+            });
+            if near_fit && group.iter().all(|&i| isolated[i as usize]) {
+                groups.push(range);
+            }
+        }
+        let climb_of = |group: &std::ops::Range<usize>| climbs[order[group.start] as usize];
         self.sharpness.clear();
         self.sharpness.extend(
             groups
                 .iter()
-                .filter_map(|group| climbs[group[0] as usize])
+                .filter_map(climb_of)
                 .map(|climb| climb.sharpness as f32)
                 .filter(|sharpness| sharpness.is_finite()),
         );
@@ -272,17 +283,19 @@ impl MatchedRefiner {
             let floor = (stats.median - FLAT_PEAK_SIGMAS * stats.sigma)
                 .min(stats.median * self.round_share);
             for group in &groups {
-                let Some(climb) = climbs[group[0] as usize] else {
-                    continue;
-                };
-                if climb.sharpness >= floor {
-                    detections[group[0] as usize].pos_px = climb.pos_px;
-                    for &twin in &group[1..] {
+                if let Some(climb) = climb_of(group)
+                    && climb.sharpness >= floor
+                    && let Some((leader, twins)) = order[group.clone()].split_first()
+                {
+                    detections[*leader as usize].pos_px = climb.pos_px;
+                    for &twin in twins {
                         self.twins[twin as usize] = true;
                     }
                 }
             }
         }
+        self.isolated = isolated;
+        self.groups = groups;
         self.climbs = climbs;
         self.order = order;
     }
@@ -463,8 +476,9 @@ fn phase_spread(dog: &mut DogFilter, sigma_px: f64) -> f64 {
 /// peak is in its flattest direction. A single Gaussian particle gives the same in every
 /// direction; two that overlap give a flat ridge along the line joining them. A direction
 /// whose neighbours are not both positive does not count (a narrow peak falls below zero
-/// within a pixel there); +∞ when none counts, `None` when the centre is not positive. (One logarithm: `2 ln c − ln a − ln b = ln(c² / ab)`, and the least
-/// of the logarithms is the logarithm of the least ratio.)
+/// within a pixel there: it is not the flat one); +∞ when none counts, `None` when the centre
+/// is not positive. (One logarithm: `2 ln c − ln a − ln b = ln(c² / ab)`, and the least of the
+/// logarithms is the logarithm of the least ratio.)
 fn sharpness(image: &GrayImage, x: usize, y: usize) -> Option<f64> {
     let at = |dx: isize, dy: isize| {
         f64::from(image.get((x as isize + dx) as usize, (y as isize + dy) as usize))
@@ -474,8 +488,6 @@ fn sharpness(image: &GrayImage, x: usize, y: usize) -> Option<f64> {
         return None;
     }
     let centre_sq = centre * centre;
-    // A direction whose neighbours are not both positive falls off faster than any
-    // log-curvature measures: it is not the flat one.
     let ratio = |dx: isize, dy: isize| {
         let (a, b) = (at(-dx, -dy), at(dx, dy));
         if a > 0.0 && b > 0.0 {
