@@ -3,6 +3,7 @@
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
+use sillage::PipelineConfig;
 use sillage::ptv_accuracy_bench::{FamilyRow, Half, Recoveries, family, moderate_family, run_case};
 
 use crate::shared_args::JsonArg;
@@ -46,6 +47,9 @@ pub struct BenchPtvAccuracyArgs {
     /// Skip the grid search (defaults and old defaults only; much faster).
     #[arg(long)]
     pub no_search: bool,
+    /// Score the defaults with this key set, e.g. `--set detector.deblend=true` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// `--json`: a machine-readable table on stdout.
     #[command(flatten)]
     pub json: JsonArg,
@@ -53,6 +57,11 @@ pub struct BenchPtvAccuracyArgs {
 
 /// `sillage bench ptv-accuracy`.
 pub fn run(args: &BenchPtvAccuracyArgs) -> Result<()> {
+    let mut defaults = PipelineConfig::default();
+    for assignment in &args.set {
+        defaults.set(assignment)?;
+    }
+    defaults.validate()?;
     let cases = match args.family {
         FamilyArg::Main => family(),
         FamilyArg::Moderate => moderate_family(),
@@ -89,7 +98,7 @@ pub fn run(args: &BenchPtvAccuracyArgs) -> Result<()> {
     }
     let mut rows = Vec::new();
     for case in &cases {
-        let row = run_case(case, args.size, args.frames, !args.no_search)?;
+        let row = run_case(case, args.size, args.frames, !args.no_search, &defaults)?;
         if !args.json.enabled {
             print_row(&row);
         }

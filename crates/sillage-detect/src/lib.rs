@@ -36,6 +36,7 @@
 
 pub mod bead;
 pub mod blob;
+mod deblend;
 mod matched_refine;
 pub mod motion;
 pub mod particle_size;

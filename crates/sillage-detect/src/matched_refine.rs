@@ -17,6 +17,8 @@
 //! scale): they become one detection, re-fitted.
 
 use rayon::prelude::*;
+
+use crate::deblend::Deblender;
 use sillage_core::{Detection, GrayImage, Point2, Result};
 use sillage_image::{
     DogFilter, Peak, PeakFinder, Polarity, SubpixelFit, median_mad_of, refine_peak,
@@ -103,11 +105,14 @@ pub(crate) struct MatchedRefiner {
     /// The completion's candidates, in peak order (reused).
     added: Vec<Option<Detection>>,
     grid: (usize, usize),
+    /// Splits the detections that are two particles (`detector.deblend`).
+    deblender: Option<Deblender>,
 }
 
 impl MatchedRefiner {
-    /// A refiner for particle images of std `sigma_px`.
-    pub(crate) fn new(sigma_px: f64) -> Result<Self> {
+    /// A refiner for particle images of std `sigma_px`, which also splits unresolved pairs
+    /// with `deblend`.
+    pub(crate) fn new(sigma_px: f64, deblend: bool) -> Result<Self> {
         let mut dog = DogFilter::new(sigma_px)?;
         let round_share = phase_spread(&mut dog, sigma_px).min(ROUND_PEAK_SHARE);
         Ok(Self {
@@ -129,6 +134,7 @@ impl MatchedRefiner {
             sharpness: Vec::new(),
             added: Vec::new(),
             grid: (1, 1),
+            deblender: deblend.then(|| Deblender::new(sigma_px)),
         })
     }
 
@@ -155,6 +161,10 @@ impl MatchedRefiner {
         let mut twins = self.twins.iter();
         detections.retain(|_| !twins.next().copied().unwrap_or(false));
         detections.extend(self.added.iter().flatten());
+        if let Some(deblender) = &mut self.deblender {
+            let sign = f64::from(polarity.sign());
+            deblender.split(input, sign, &self.matched, offset, detections);
+        }
     }
 
     /// Finds the matched image's peaks above `threshold` that no detection is near (faint
@@ -558,7 +568,7 @@ mod tests {
 
     /// The re-fits of `detections` on `frame`, at σ = `SIGMA_PX`, adding no faint particles.
     fn refine_without_completion(frame: &GrayImage, detections: &mut Vec<Detection>) {
-        let mut refiner = MatchedRefiner::new(SIGMA_PX).unwrap();
+        let mut refiner = MatchedRefiner::new(SIGMA_PX, false).unwrap();
         refiner.refine(
             frame,
             Polarity::Bright,

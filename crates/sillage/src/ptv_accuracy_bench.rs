@@ -294,11 +294,17 @@ pub struct FamilyRow {
     pub tuned: Option<(GridSetting, Recoveries)>,
 }
 
-/// Runs `case` on `size`² frames, `frames` long: defaults, old defaults and, when `search`,
-/// the grid.
-pub fn run_case(case: &FamilyCase, size: usize, frames: usize, search: bool) -> Result<FamilyRow> {
+/// Runs `case` on `size`² frames, `frames` long: `defaults` (the library's, or with some keys
+/// set), old defaults and, when `search`, the grid.
+pub fn run_case(
+    case: &FamilyCase,
+    size: usize,
+    frames: usize,
+    search: bool,
+    defaults: &PipelineConfig,
+) -> Result<FamilyRow> {
     let data = CaseData::render(case, size, frames)?;
-    let defaults = Recoveries::from(&data.score(&PipelineConfig::default())?);
+    let defaults = Recoveries::from(&data.score(defaults)?);
     let old = GridSetting {
         scale_px: 2.0,
         noise_k: sillage_detect::DEFAULT_NOISE_K,
@@ -426,7 +432,7 @@ mod tests {
             intermittency: 0.0,
             seed: FAMILY_SEED,
         };
-        let row = run_case(&case, 128, 6, false).unwrap();
+        let row = run_case(&case, 128, 6, false, &PipelineConfig::default()).unwrap();
         assert_eq!(row.particles, 82);
         assert!(row.tuned.is_none());
         let sigma = row.measured_sigma_px.unwrap();

@@ -41,7 +41,11 @@ fn blob_scale_variants_on_the_tune_halves() {
         .filter(|c| c.half == Half::Tune)
         .collect();
     for case in &tune {
-        let tuned = run_case(case, 512, 10, true).unwrap().tuned.unwrap().1;
+        let tuned = run_case(case, 512, 10, true, &PipelineConfig::default())
+            .unwrap()
+            .tuned
+            .unwrap()
+            .1;
         let results = sweep(case, 512, 10, &functions).unwrap();
         let line: Vec<String> = results
             .iter()
