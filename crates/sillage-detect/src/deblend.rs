@@ -10,9 +10,9 @@
 //! window of the frame is fitted by least squares with a constant background, Gaussians of
 //! the measured σ at the detection and at the other detections nearby, their amplitudes free
 //! (a screen). Where that leaves more than [`SPLIT_CHI2`] noise variances of residual above
-//! its degrees of freedom, the window is fitted again (Levenberg–Marquardt) with one and with
-//! two Gaussians of a free common width and free centres, the neighbours' amplitudes free:
-//! the pair replaces the detection when it lowers the residual by more than [`SPLIT_CHI2`]
+//! its degrees of freedom, the neighbours are subtracted with the screen's amplitudes and the
+//! window is fitted again (Levenberg–Marquardt) with one and with two Gaussians of a free
+//! common width and free centres: the pair replaces the detection when it lowers the residual by more than [`SPLIT_CHI2`]
 //! noise variances, both amplitudes are positive and the two lie at least
 //! [`MIN_SEPARATION_SIGMAS`] σ apart, inside the window and off the neighbours. The noise
 //! variance is the median residual variance of the screens of a sample of round peaks (mostly
@@ -28,9 +28,9 @@ use sillage_core::{Detection, GrayImage, Point2, Vec2};
 /// families (36 cases; without deblending 33 within 2 points of tuned, mean true / false
 /// 73.7 / 9.25 %), on a first form of this module (every flat peak fitted, the noise from the
 /// pair fits): 0.5 → 33 cases, 74.6 / 9.3 %; 0.7 → 36, 76.6 / 9.0; 0.85 → 36, 77.4 / 8.7; 0.9
-/// → 35, 77.4 / 8.9; 1 (no gate) → 35, 77.4 / 9.1. The form kept gives 36, 77.3 / 8.3 there;
+/// → 35, 77.4 / 8.9; 1 (no gate) → 35, 77.4 / 9.1. The form kept gives 36, 77.6 / 8.4 there;
 /// on the report halves (unseen) 35 → 36 of 36 cases within 2 points of tuned and 70.5 /
-/// 12.0 → 73.9 / 11.3 % (docs/ptv.md, "Overlapping particles split").
+/// 12.0 → 74.1 / 11.5 % (docs/ptv.md, "Overlapping particles split").
 pub const FLATNESS_GATE: f64 = 0.85;
 /// Least drop of the squared residual, in noise variances, for which two particles replace
 /// one (and least excess of the screen's residual for the fits to run). Tuned with
@@ -73,11 +73,13 @@ struct Screen {
     dof: usize,
 }
 
-/// Buffers of one rayon task: the neighbours, the window's values, the Gaussian factors.
+/// Buffers of one rayon task: the neighbours, the window's values (as read, and with the
+/// neighbours subtracted), the Gaussian factors.
 #[derive(Debug, Default)]
 struct Scratch {
     others: Vec<Point2>,
     values: Vec<f64>,
+    cleaned: Vec<f64>,
     factors: Factors,
 }
 
@@ -140,6 +142,7 @@ impl Deblender {
                     others,
                     values,
                     factors,
+                    ..
                 } = scratch;
                 if !gather(others, i) {
                     return (None, None);
@@ -149,7 +152,7 @@ impl Deblender {
                     return (None, None);
                 };
                 let model = Model::new(&window, others, 1, this.sigma_px);
-                let Some(residual) = model.linear_residual(&[local(i)], factors) else {
+                let Some((residual, _)) = model.linear_fit(&[local(i)], factors) else {
                     return (None, None);
                 };
                 let dof = window.len().saturating_sub(2 + others.len()).max(1);
@@ -178,12 +181,20 @@ impl Deblender {
                         let Scratch {
                             others,
                             values,
+                            cleaned,
                             factors,
                         } = scratch;
                         gather(others, i);
-                        let window =
-                            Window::around(input, sign, local(i), this.half_width, values)?;
-                        let pair = this.fit_pair(&window, others, local(i), noise, factors)?;
+                        let p = local(i);
+                        let window = Window::around(input, sign, p, this.half_width, values)?;
+                        let clean = window.without_neighbours(
+                            p,
+                            others,
+                            this.sigma_px,
+                            cleaned,
+                            factors,
+                        )?;
+                        let pair = this.fit_pair(&clean, others, p, noise, factors)?;
                         Some((i, pair))
                     })
                     .flatten()
@@ -199,8 +210,9 @@ impl Deblender {
         self.screens = screens;
     }
 
-    /// The pair that replaces the detection at `p`, if two particles fit `window` better than
-    /// one by [`SPLIT_CHI2`] noise variances (`noise`) and are a pair (see the module).
+    /// The pair that replaces the detection at `p`, if two particles fit `window` (its
+    /// neighbours `others` subtracted) better than one by [`SPLIT_CHI2`] noise variances
+    /// (`noise`) and are a pair (see the module).
     fn fit_pair(
         &self,
         window: &Window<'_>,
@@ -210,12 +222,12 @@ impl Deblender {
         factors: &mut Factors,
     ) -> Option<[Point2; 2]> {
         let sigma = self.sigma_px;
-        let one = Model::new(window, others, 1, sigma).fit(&[p], factors);
+        let one = Model::new(window, &[], 1, sigma).fit(&[p], factors);
         // The two start σ/2 on each side of the detection along the axis where the window's
         // signal spreads most.
         let axis = window.major_axis(p);
         let start = [p + axis * (0.5 * sigma), p + axis * (-0.5 * sigma)];
-        let two = Model::new(window, others, 2, sigma).fit(&start, factors);
+        let two = Model::new(window, &[], 2, sigma).fit(&start, factors);
         let core = self.half_width as f64 - 1.0;
         let min_separation = MIN_SEPARATION_SIGMAS * sigma;
         let inside = |q: Point2| (q.x - p.x).abs() <= core && (q.y - p.y).abs() <= core;
@@ -305,6 +317,43 @@ impl<'v> Window<'v> {
         self.values.len()
     }
 
+    /// This window with the particles at `others` subtracted: Gaussians of std `sigma` with
+    /// the amplitudes of the linear fit of a background and particles at `p` and `others`
+    /// (stored in `cleaned`); `None` when that fit is singular.
+    fn without_neighbours<'c>(
+        &self,
+        p: Point2,
+        others: &[Point2],
+        sigma: f64,
+        cleaned: &'c mut Vec<f64>,
+        factors: &mut Factors,
+    ) -> Option<Window<'c>> {
+        let (_, solution) = Model::new(self, others, 1, sigma).linear_fit(&[p], factors)?;
+        let side = self.side;
+        cleaned.clear();
+        cleaned.extend_from_slice(self.values);
+        // Component 0 is the particle at `p`; the neighbours follow, amplitudes after the
+        // background and the particle's.
+        for c in 1..=others.len() {
+            let amplitude = solution[1 + c];
+            let (gx, gy) = (
+                &factors.gx[c * side..][..side],
+                &factors.gy[c * side..][..side],
+            );
+            for (row, &fy) in cleaned.chunks_exact_mut(side).zip(gy) {
+                for (v, &fx) in row.iter_mut().zip(gx) {
+                    *v -= amplitude * fy * fx;
+                }
+            }
+        }
+        Some(Window {
+            x0: self.x0,
+            y0: self.y0,
+            side,
+            values: cleaned,
+        })
+    }
+
     /// The unit direction along which the window's signal above its median spreads most
     /// about `p` (the major axis of its second moments).
     fn major_axis(&self, p: Point2) -> Vec2 {
@@ -371,14 +420,6 @@ impl<'a> Model<'a> {
         }
     }
 
-    fn amplitude_index(&self, c: usize) -> usize {
-        if c < self.free {
-            2 + 3 * c
-        } else {
-            2 + 3 * self.free + (c - self.free)
-        }
-    }
-
     /// Per component, its Gaussian factors of width `s` along the window's columns and rows
     /// (into the scratch's `gx`, `gy`).
     fn factors(&self, theta: &Params, s: f64, factors: &mut Factors) {
@@ -399,9 +440,11 @@ impl<'a> Model<'a> {
         }
     }
 
-    /// The squared residual of the linear least-squares fit with the free particles at
-    /// `centres` and the measured σ (background and amplitudes only); `None` when singular.
-    fn linear_residual(&self, centres: &[Point2], factors: &mut Factors) -> Option<f64> {
+    /// The linear least-squares fit with the free particles at `centres` and the measured σ
+    /// (background and amplitudes only): its squared residual and its solution (background,
+    /// then one amplitude per component); `None` when singular. Leaves the components'
+    /// factors in `factors`.
+    fn linear_fit(&self, centres: &[Point2], factors: &mut Factors) -> Option<(f64, Params)> {
         let mut theta = [0.0; MAX_PARAMETERS];
         for (c, centre) in centres.iter().enumerate() {
             theta[3 + 3 * c] = centre.x;
@@ -437,7 +480,7 @@ impl<'a> Model<'a> {
             return None;
         }
         let explained: f64 = (0..n).map(|a| projection[a] * solution[a]).sum();
-        Some((total - explained).max(0.0))
+        Some(((total - explained).max(0.0), solution))
     }
 
     /// Levenberg–Marquardt from the free particles at `start` with the measured σ; `None`
@@ -486,7 +529,7 @@ impl<'a> Model<'a> {
                 theta = trial;
                 residual = self.accumulate(&theta, factors, Some((&mut normal, &mut gradient)));
                 lambda = (lambda * 0.1).max(1e-9);
-                if gain < 1e-6 {
+                if gain < 1e-4 {
                     break;
                 }
             } else {
@@ -504,61 +547,92 @@ impl<'a> Model<'a> {
         })
     }
 
-    /// The squared residual at `theta`; with `system`, also JᵀJ and Jᵀr.
+    /// The squared residual at `theta`; with `system`, also JᵀJ and Jᵀr (the fits have free
+    /// particles only: one or two).
     fn accumulate(
         &self,
         theta: &Params,
         factors: &mut Factors,
-        mut system: Option<(&mut Normal, &mut Params)>,
+        system: Option<(&mut Normal, &mut Params)>,
     ) -> f64 {
-        let n = self.parameters();
+        debug_assert!(
+            self.fixed.is_empty(),
+            "fitted models have free particles only"
+        );
+        self.factors(theta, theta[1], factors);
+        match (self.free, system) {
+            (1, Some(system)) => self.accumulate_system::<5>(theta, factors, system),
+            (_, Some(system)) => self.accumulate_system::<8>(theta, factors, system),
+            (_, None) => self.residual(theta, factors),
+        }
+    }
+
+    /// The squared residual at `theta`, the factors already computed.
+    fn residual(&self, theta: &Params, factors: &Factors) -> f64 {
+        let (w, side) = (self.window, self.window.side);
+        let mut total = 0.0;
+        for (row, values) in w.values.chunks_exact(side).enumerate() {
+            for (col, &z) in values.iter().enumerate() {
+                let mut value = theta[0];
+                for c in 0..self.free {
+                    value +=
+                        theta[2 + 3 * c] * factors.gx[c * side + col] * factors.gy[c * side + row];
+                }
+                total += (z - value).powi(2);
+            }
+        }
+        total
+    }
+
+    /// The squared residual at `theta` with JᵀJ and Jᵀr for `N` parameters, the factors
+    /// already computed.
+    fn accumulate_system<const N: usize>(
+        &self,
+        theta: &Params,
+        factors: &Factors,
+        (normal, gradient): (&mut Normal, &mut Params),
+    ) -> f64 {
         let (w, side) = (self.window, self.window.side);
         let s = theta[1];
-        self.factors(theta, s, factors);
-        if let Some((normal, gradient)) = system.as_mut() {
-            normal.fill(0.0);
-            gradient.fill(0.0);
-        }
         let inv_s2 = 1.0 / (s * s);
+        let inv_s3 = inv_s2 / s;
+        let free = (N - 2) / 3;
+        let mut upper = [[0.0; N]; N];
+        let mut projection = [0.0; N];
         let mut total = 0.0;
-        let mut jac: Params = [0.0; MAX_PARAMETERS];
-        for row in 0..side {
+        for (row, values) in w.values.chunks_exact(side).enumerate() {
             let y = (w.y0 + row) as f64;
-            for col in 0..side {
+            for (col, &z) in values.iter().enumerate() {
                 let x = (w.x0 + col) as f64;
-                let mut value = theta[0];
+                let mut jac = [0.0; N];
                 jac[0] = 1.0;
-                jac[1] = 0.0;
-                for c in 0..self.components() {
+                let mut value = theta[0];
+                for c in 0..free {
                     let g = factors.gx[c * side + col] * factors.gy[c * side + row];
-                    let index = self.amplitude_index(c);
-                    let ag = theta[index] * g;
+                    let ag = theta[2 + 3 * c] * g;
+                    let (dx, dy) = (x - theta[3 + 3 * c], y - theta[4 + 3 * c]);
                     value += ag;
-                    if system.is_some() {
-                        let centre = self.centre(theta, c);
-                        let (dx, dy) = (x - centre.x, y - centre.y);
-                        jac[1] += ag * (dx * dx + dy * dy) * inv_s2 / s;
-                        jac[index] = g;
-                        if c < self.free {
-                            jac[index + 1] = ag * dx * inv_s2;
-                            jac[index + 2] = ag * dy * inv_s2;
-                        }
-                    }
+                    jac[1] += ag * (dx * dx + dy * dy) * inv_s3;
+                    jac[2 + 3 * c] = g;
+                    jac[3 + 3 * c] = ag * dx * inv_s2;
+                    jac[4 + 3 * c] = ag * dy * inv_s2;
                 }
-                let r = w.values[row * side + col] - value;
+                let r = z - value;
                 total += r * r;
-                if let Some((normal, gradient)) = system.as_mut() {
-                    for a in 0..n {
-                        gradient[a] += jac[a] * r;
-                        for b in a..n {
-                            normal[a * n + b] += jac[a] * jac[b];
-                        }
+                for a in 0..N {
+                    projection[a] += jac[a] * r;
+                    for b in a..N {
+                        upper[a][b] += jac[a] * jac[b];
                     }
                 }
             }
         }
-        if let Some((normal, _)) = system.as_mut() {
-            mirror(&mut normal[..], n);
+        for a in 0..N {
+            gradient[a] = projection[a];
+            for b in a..N {
+                normal[a * N + b] = upper[a][b];
+                normal[b * N + a] = upper[a][b];
+            }
         }
         total
     }
