@@ -83,11 +83,13 @@ struct Scratch {
     factors: Factors,
 }
 
-/// Per component of a model, its Gaussian factors along the window's columns and rows.
+/// Per component of a model, its Gaussian factors along the window's columns and rows; and
+/// the window's values sorted, for its median ([`Window::major_axis`]).
 #[derive(Debug, Default)]
 struct Factors {
     gx: Vec<f64>,
     gy: Vec<f64>,
+    sorted: Vec<f64>,
 }
 
 impl Deblender {
@@ -225,7 +227,7 @@ impl Deblender {
         let one = Model::new(window, &[], 1, sigma).fit(&[p], factors);
         // The two start σ/2 on each side of the detection along the axis where the window's
         // signal spreads most.
-        let axis = window.major_axis(p);
+        let axis = window.major_axis(p, &mut factors.sorted);
         let start = [p + axis * (0.5 * sigma), p + axis * (-0.5 * sigma)];
         let two = Model::new(window, &[], 2, sigma).fit(&start, factors);
         let core = self.half_width as f64 - 1.0;
@@ -355,9 +357,10 @@ impl<'v> Window<'v> {
     }
 
     /// The unit direction along which the window's signal above its median spreads most
-    /// about `p` (the major axis of its second moments).
-    fn major_axis(&self, p: Point2) -> Vec2 {
-        let mut sorted = self.values.to_vec();
+    /// about `p` (the major axis of its second moments); `sorted` is a reused buffer.
+    fn major_axis(&self, p: Point2, sorted: &mut Vec<f64>) -> Vec2 {
+        sorted.clear();
+        sorted.extend_from_slice(self.values);
         let mid = sorted.len() / 2;
         let floor = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
         let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
