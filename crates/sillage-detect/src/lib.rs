@@ -36,6 +36,7 @@
 
 pub mod bead;
 pub mod blob;
+mod cell_grid;
 mod deblend;
 mod matched_refine;
 pub mod motion;

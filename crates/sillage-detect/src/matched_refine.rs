@@ -18,6 +18,7 @@
 
 use rayon::prelude::*;
 
+use crate::cell_grid::CellGrid;
 use crate::deblend::Deblender;
 use sillage_core::{Detection, GrayImage, Point2, Result};
 use sillage_image::{
@@ -84,8 +85,8 @@ pub(crate) struct MatchedRefiner {
     isolation_px: f64,
     finder: PeakFinder,
     peaks: Vec<Peak>,
-    cell_start: Vec<u32>,
-    cell_members: Vec<u32>,
+    /// The detections bucketed in cells as wide as the isolation radius.
+    grid: CellGrid,
     /// Whether each detection's neighbours within the isolation radius all lie within the
     /// merge radius (possible twins from one particle), so that it is climbed.
     candidate: Vec<bool>,
@@ -104,7 +105,6 @@ pub(crate) struct MatchedRefiner {
     sharpness: Vec<f32>,
     /// The completion's candidates, in peak order (reused).
     added: Vec<Option<Detection>>,
-    grid: (usize, usize),
     /// Splits the detections that are two particles (`detector.deblend`).
     deblender: Option<Deblender>,
 }
@@ -123,8 +123,7 @@ impl MatchedRefiner {
             isolation_px: ISOLATION_SIGMAS * sigma_px,
             finder: PeakFinder::default(),
             peaks: Vec::new(),
-            cell_start: Vec::new(),
-            cell_members: Vec::new(),
+            grid: CellGrid::default(),
             candidate: Vec::new(),
             climbs: Vec::new(),
             isolated: Vec::new(),
@@ -133,7 +132,6 @@ impl MatchedRefiner {
             twins: Vec::new(),
             sharpness: Vec::new(),
             added: Vec::new(),
-            grid: (1, 1),
             deblender: deblend.then(|| Deblender::new(sigma_px)),
         })
     }
@@ -194,12 +192,12 @@ impl MatchedRefiner {
                 // within the merge radius of the pixel is within it of the fit too, and
                 // most matched peaks are the particles already found.
                 let pixel = Point2::new(peak.x as f64 + offset.0, peak.y as f64 + offset.1);
-                if this.nearest_within(pixel, offset, found, merge_sure2) {
+                if this.nearest_within(pixel, found, merge_sure2) {
                     return None;
                 }
                 let local = refine_peak(&this.matched, peak.x, peak.y, fit)?;
                 let p = Point2::new(local.x + offset.0, local.y + offset.1);
-                (!this.nearest_within(p, offset, found, merge2))
+                (!this.nearest_within(p, found, merge2))
                     .then(|| Detection::new(p, this.matched.get(peak.x, peak.y)))
             })
             .collect_into_vec(&mut added);
@@ -249,7 +247,7 @@ impl MatchedRefiner {
                     return false;
                 };
                 let p = detections[i].pos_px;
-                !this.any_neighbour(p, offset, |j| {
+                !this.any_neighbour(p, |j| {
                     j != i && {
                         let q = detections[j].pos_px;
                         (q.x - p.x).powi(2) + (q.y - p.y).powi(2) < r2
@@ -320,31 +318,7 @@ impl MatchedRefiner {
         detections: &[Detection],
     ) {
         let r = self.isolation_px;
-        let (cols, rows) = (
-            (width as f64 / r).ceil() as usize + 1,
-            (height as f64 / r).ceil() as usize + 1,
-        );
-        self.grid = (cols, rows);
-        self.cell_start.clear();
-        self.cell_start.resize(cols * rows + 1, 0);
-        for d in detections {
-            let (cx, cy) = self.cell_of(d.pos_px, offset);
-            self.cell_start[cy * cols + cx + 1] += 1;
-        }
-        for i in 1..self.cell_start.len() {
-            self.cell_start[i] += self.cell_start[i - 1];
-        }
-        self.cell_members.clear();
-        self.cell_members.resize(detections.len(), 0);
-        // Each cell's start serves as its fill cursor, then is shifted back into place.
-        for (i, d) in detections.iter().enumerate() {
-            let (cx, cy) = self.cell_of(d.pos_px, offset);
-            let slot = &mut self.cell_start[cy * cols + cx];
-            self.cell_members[*slot as usize] = i as u32;
-            *slot += 1;
-        }
-        self.cell_start.copy_within(0..cols * rows, 1);
-        self.cell_start[0] = 0;
+        self.grid.rebuild((width, height), detections, offset, r);
         let r2 = r * r;
         let twin2 = (MERGE_SIGMAS * self.sigma_px).powi(2);
         let mut candidate = std::mem::take(&mut self.candidate);
@@ -354,7 +328,7 @@ impl MatchedRefiner {
             .enumerate()
             .with_min_len(PAR_MIN_LEN)
             .map(|(i, d)| {
-                !this.any_neighbour(d.pos_px, offset, |j| {
+                !this.any_neighbour(d.pos_px, |j| {
                     j != i && {
                         let q = detections[j].pos_px;
                         let d2 = (q.x - d.pos_px.x).powi(2) + (q.y - d.pos_px.y).powi(2);
@@ -366,46 +340,15 @@ impl MatchedRefiner {
         self.candidate = candidate;
     }
 
-    /// The grid cell of position `p` (with `offset`).
-    fn cell_of(&self, p: Point2, offset: (f64, f64)) -> (usize, usize) {
-        let (cols, rows) = self.grid;
-        let cx = ((p.x - offset.0).max(0.0) / self.isolation_px) as usize;
-        let cy = ((p.y - offset.1).max(0.0) / self.isolation_px) as usize;
-        (cx.min(cols - 1), cy.min(rows - 1))
-    }
-
-    /// Whether `test` holds for one of the members of the cells around `p`'s (the grid built
-    /// by [`MatchedRefiner::mark_isolated`]); stops at the first.
-    fn any_neighbour(
-        &self,
-        p: Point2,
-        offset: (f64, f64),
-        mut test: impl FnMut(usize) -> bool,
-    ) -> bool {
-        let (cols, rows) = self.grid;
-        let (cx, cy) = self.cell_of(p, offset);
-        for y in cy.saturating_sub(1)..=(cy + 1).min(rows - 1) {
-            // The three cells of a row are contiguous in `cell_members`.
-            let first = y * cols + cx.saturating_sub(1);
-            let last = y * cols + (cx + 1).min(cols - 1);
-            let members = &self.cell_members
-                [self.cell_start[first] as usize..self.cell_start[last + 1] as usize];
-            if members.iter().any(|&j| test(j as usize)) {
-                return true;
-            }
-        }
-        false
+    /// Whether `test` holds for one of the detections in the grid cells around `p`'s (the
+    /// grid built by [`MatchedRefiner::mark_candidates`]); stops at the first.
+    fn any_neighbour(&self, p: Point2, test: impl FnMut(usize) -> bool) -> bool {
+        self.grid.near(p).any(test)
     }
 
     /// Whether one of `detections` (those the grid was built on) lies within `√r2` of `p`.
-    fn nearest_within(
-        &self,
-        p: Point2,
-        offset: (f64, f64),
-        detections: &[Detection],
-        r2: f64,
-    ) -> bool {
-        self.any_neighbour(p, offset, |j| {
+    fn nearest_within(&self, p: Point2, detections: &[Detection], r2: f64) -> bool {
+        self.any_neighbour(p, |j| {
             let q = detections[j].pos_px;
             (q.x - p.x).powi(2) + (q.y - p.y).powi(2) < r2
         })
