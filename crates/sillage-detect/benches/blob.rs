@@ -1,6 +1,8 @@
 //! Blob detection on a 2048² frame with ~25,000 Gaussian spots (σ = 1.2 px) and noise, seeded:
 //! the defaults (scale and polarity measured on the first call, then the matched-scale second
-//! look), a given scale (no second look), and the measurement itself (once per run).
+//! look), a given scale (no second look), and the measurement itself (once per run). Then
+//! the same seeding at σ = 2 px, where particle images overlap, without and with
+//! `detector.deblend`.
 //! Run with `cargo bench -p sillage-detect --bench blob`.
 
 #[path = "../tests/common/mod.rs"]
@@ -56,5 +58,34 @@ fn bench_blob(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_blob);
+fn bench_deblend(c: &mut Criterion) {
+    let side = 2048;
+    let mut rng = Rng(2024);
+    let spots: Vec<Spot> = (0..25_000)
+        .map(|_| Spot {
+            x: rng.uniform() * side as f64,
+            y: rng.uniform() * side as f64,
+            amplitude: 0.3 + 0.5 * rng.uniform(),
+        })
+        .collect();
+    let frame = render(side, side, 0.1, &spots, 2.0, 0.02, &mut rng);
+    let mut group = c.benchmark_group("blob_2048x2048_25k_sigma2");
+    group.sample_size(10);
+    for deblend in [false, true] {
+        let mut detector = BlobDetector::new(BlobParams {
+            deblend,
+            ..BlobParams::default()
+        })
+        .unwrap();
+        let mut out = Vec::new();
+        detector.detect(&frame, &mut out).unwrap();
+        let name = if deblend { "deblend" } else { "defaults" };
+        group.bench_function(name, |b| {
+            b.iter(|| detector.detect(black_box(&frame), &mut out).unwrap())
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_blob, bench_deblend);
 criterion_main!(benches);
