@@ -36,7 +36,7 @@ use window::Window;
 /// pair fits): 0.5 → 33 cases, 74.6 / 9.3 %; 0.7 → 36, 76.6 / 9.0; 0.85 → 36, 77.4 / 8.7; 0.9
 /// → 35, 77.4 / 8.9; 1 (no gate) → 35, 77.4 / 9.1. The form kept gives 36, 77.6 / 8.4 there;
 /// on the report halves (unseen) 35 → 36 of 36 cases within 2 points of tuned and 70.5 /
-/// 12.0 → 74.1 / 11.5 % (docs/ptv.md, "Overlapping particles split").
+/// 12.0 → 74.1 / 11.4 % (docs/ptv.md, "Overlapping particles split").
 pub const FLATNESS_GATE: f64 = 0.85;
 /// Least drop of the squared residual, in noise variances, for which two particles replace
 /// one (and least excess of the screen's residual for the fits to run). Tuned with
