@@ -12,12 +12,13 @@ use std::hint::black_box;
 
 use common::{Rng, Spot, render};
 use criterion::{Criterion, criterion_group, criterion_main};
-use sillage_core::Detector;
+use sillage_core::{Detector, GrayImage};
 use sillage_detect::{
     BlobDetector, BlobFilter, BlobParams, PolarityChoice, Scale, measure_particle_images,
 };
 
-fn bench_blob(c: &mut Criterion) {
+/// The 2048² frame of the 25,000 seeded spots, images of std `sigma_px`.
+fn frame(sigma_px: f64) -> GrayImage {
     let side = 2048;
     let mut rng = Rng(2024);
     let spots: Vec<Spot> = (0..25_000)
@@ -27,7 +28,11 @@ fn bench_blob(c: &mut Criterion) {
             amplitude: 0.3 + 0.5 * rng.uniform(),
         })
         .collect();
-    let frame = render(side, side, 0.1, &spots, 1.2, 0.02, &mut rng);
+    render(side, side, 0.1, &spots, sigma_px, 0.02, &mut rng)
+}
+
+fn bench_blob(c: &mut Criterion) {
+    let frame = frame(1.2);
     let mut group = c.benchmark_group("blob_2048x2048_25k");
     for filter in [BlobFilter::Dog, BlobFilter::Log] {
         let mut detector = BlobDetector::new(BlobParams {
@@ -59,16 +64,7 @@ fn bench_blob(c: &mut Criterion) {
 }
 
 fn bench_deblend(c: &mut Criterion) {
-    let side = 2048;
-    let mut rng = Rng(2024);
-    let spots: Vec<Spot> = (0..25_000)
-        .map(|_| Spot {
-            x: rng.uniform() * side as f64,
-            y: rng.uniform() * side as f64,
-            amplitude: 0.3 + 0.5 * rng.uniform(),
-        })
-        .collect();
-    let frame = render(side, side, 0.1, &spots, 2.0, 0.02, &mut rng);
+    let frame = frame(2.0);
     let mut group = c.benchmark_group("blob_2048x2048_25k_sigma2");
     group.sample_size(10);
     for deblend in [false, true] {
