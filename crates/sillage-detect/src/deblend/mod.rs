@@ -70,7 +70,11 @@ const PAR_MIN_LEN: usize = 64;
 pub(crate) struct Deblender {
     sigma_px: f64,
     half_width: usize,
-    screens: Vec<Option<Screen>>,
+    /// Per detection of the frame: its screen if it is a flat peak, its residual variance if
+    /// it is a sampled round one (reused between frames).
+    screens: Vec<(Option<Screen>, Option<f64>)>,
+    /// The sampled round peaks' residual variances (reused).
+    variances: Vec<f64>,
     /// The detections bucketed in cells as wide as the reach of a neighbour.
     grid: CellGrid,
 }
@@ -102,6 +106,7 @@ impl Deblender {
             sigma_px,
             half_width: (WINDOW_SIGMAS * sigma_px).ceil().max(2.0) as usize,
             screens: Vec::new(),
+            variances: Vec::new(),
             grid: CellGrid::default(),
         }
     }
@@ -121,6 +126,7 @@ impl Deblender {
         self.grid
             .rebuild(input.dimensions(), detections, offset, reach);
         let mut screens = std::mem::take(&mut self.screens);
+        let mut variances = std::mem::take(&mut self.variances);
         let this = &*self;
         let found: &[Detection] = detections;
         let local = |i: usize| {
@@ -129,9 +135,9 @@ impl Deblender {
         };
         // Detection `i` then its neighbours, false when there are too many.
         let gather = |centres: &mut Vec<Point2>, i: usize| {
-            centres.clear();
-            centres.push(local(i));
             let p = local(i);
+            centres.clear();
+            centres.push(p);
             let near = this.grid.near(found[i].pos_px).filter(|&j| j != i);
             centres.extend(near.map(local).filter(|q| q.distance(p) < reach));
             centres.len() <= 1 + MAX_NEIGHBOURS
@@ -139,8 +145,7 @@ impl Deblender {
         // Flat peaks are screened; so is a sample of the round ones (every `stride`-th
         // detection), whose residuals, mostly single particles', measure the noise.
         let stride = (found.len() / NOISE_SAMPLE).max(1);
-        let mut variances: Vec<f64> = Vec::new();
-        let screened: Vec<(Option<Screen>, Option<f64>)> = (0..found.len())
+        (0..found.len())
             .into_par_iter()
             .with_min_len(PAR_MIN_LEN)
             .map_init(Scratch::default, |scratch, i| {
@@ -169,12 +174,13 @@ impl Deblender {
                 let screen = flat.then_some(Screen { residual, dof });
                 (screen, (!flat).then_some(residual / dof as f64))
             })
-            .collect();
-        screens.clear();
-        for (screen, variance) in screened {
-            screens.push(screen);
-            variances.extend(variance.filter(|v| v.is_finite()));
-        }
+            .collect_into_vec(&mut screens);
+        variances.clear();
+        variances.extend(
+            screens
+                .iter()
+                .filter_map(|&(_, v)| v.filter(|v| v.is_finite())),
+        );
         if variances.len() >= MIN_SCREENS {
             let mid = variances.len() / 2;
             let noise = *variances.select_nth_unstable_by(mid, f64::total_cmp).1;
@@ -183,7 +189,7 @@ impl Deblender {
                     .par_iter()
                     .enumerate()
                     .with_min_len(PAR_MIN_LEN)
-                    .filter(|(_, screen)| {
+                    .filter(|(_, (screen, _))| {
                         screen
                             .is_some_and(|s| s.residual - s.dof as f64 * noise > SPLIT_CHI2 * noise)
                     })
@@ -215,6 +221,7 @@ impl Deblender {
             }
         }
         self.screens = screens;
+        self.variances = variances;
     }
 
     /// The pair that replaces the detection at `p`, if two particles fit `window` (its
