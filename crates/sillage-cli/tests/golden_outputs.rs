@@ -147,10 +147,12 @@ fn pets_ground_plane(dir: &Path) -> String {
 fn immpf_rows_on_pets_frames_are_unchanged_for_seeds_1_to_3() {
     let dir = tempfile::tempdir().unwrap();
     let ground = pets_ground_plane(dir.path());
+    // Re-pinned 2026-11-29 when the weights' normalisation took its own exponential
+    // (`fast_math`): the same rows and ids, boxes moved by at most 2·10⁻¹² px.
     let expected = [
-        (1, 0x3290_3a7c_8ed0_7a37_u64),
-        (2, 0x1d4d_0563_c0f8_8160),
-        (3, 0xb862_097d_5f91_ae84),
+        (1, 0xd203_b8ad_fdf8_50e3_u64),
+        (2, 0xf255_9a24_7fcd_fb40),
+        (3, 0x279d_974f_e22c_e2fd),
     ];
     for (seed, hash) in expected {
         let out = dir.path().join(format!("immpf_{seed}.txt"));

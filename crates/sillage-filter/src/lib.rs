@@ -60,6 +60,7 @@ pub mod resample;
 pub mod switching;
 pub mod weights;
 
+mod fast_math;
 mod filter;
 
 pub use filter::{FilterSpec, ParticleFilter, StepReport, StepSummary, step_all};

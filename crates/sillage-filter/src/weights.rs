@@ -1,6 +1,8 @@
 //! Log-domain importance weights: normalisation by log-sum-exp (Eq. (6) of the MMPF+ paper,
 //! "normalizing", §3.5.2), effective sample size and the recovery of an all-zero weight set.
 
+use crate::fast_math::exp_nonpositive;
+
 /// What one normalisation found.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Normalisation {
@@ -54,15 +56,26 @@ pub fn normalise(log_weights: &mut [f64], linear: &mut [f64]) -> Normalisation {
             recovered: true,
         };
     }
-    // One pass for Σ e and Σ e² with e = exp(x − max) ∈ [0, 1]: no overflow, and the largest
-    // term is exactly 1, so the sum cannot underflow either.
-    let (mut sum, mut sum_sq) = (0.0, 0.0);
+    // e = exp(x − max) ∈ [0, 1]: no overflow, and the largest term is exactly 1, so the sum
+    // cannot underflow either. The exponentials in one vectorisable pass, then Σ e and Σ e²
+    // over four fixed lanes (the same order, so the same bits, on every machine).
     for (lw, w) in log_weights.iter().zip(linear.iter_mut()) {
-        let e = (lw - max).exp();
-        *w = e;
-        sum += e;
-        sum_sq += e * e;
+        *w = exp_nonpositive(lw - max);
     }
+    let (mut sums, mut squares) = ([0.0; 4], [0.0; 4]);
+    let mut quads = linear.chunks_exact(4);
+    for quad in &mut quads {
+        for lane in 0..4 {
+            sums[lane] += quad[lane];
+            squares[lane] += quad[lane] * quad[lane];
+        }
+    }
+    for (lane, &e) in quads.remainder().iter().enumerate() {
+        sums[lane] += e;
+        squares[lane] += e * e;
+    }
+    let sum = (sums[0] + sums[1]) + (sums[2] + sums[3]);
+    let sum_sq = (squares[0] + squares[1]) + (squares[2] + squares[3]);
     let log_norm = max + sum.ln();
     let inv = 1.0 / sum;
     for (lw, w) in log_weights.iter_mut().zip(linear.iter_mut()) {
