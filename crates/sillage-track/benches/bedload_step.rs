@@ -8,8 +8,6 @@
 //! clone of it. Groups: MMPF+ at N = 100 and 500 particles, and the five trackers of Table 1
 //! at 400 beads, N = 100.
 
-use std::hint::black_box;
-
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
 use sillage_core::{Detection, FrameObservations, Point2, TrackPoint, Tracker, rng_stream};
