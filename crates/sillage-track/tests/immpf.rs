@@ -502,17 +502,34 @@ fn on_detections_seeded(
     boxes: impl Fn(u64) -> Vec<(f64, f64, f64)>,
     seed: u64,
 ) -> Vec<PedestrianEstimate> {
+    let sized = |frame| {
+        boxes(frame)
+            .into_iter()
+            .map(|(x, y, score)| {
+                let foot = sillage_core::Point2::new(x, y);
+                Candidate {
+                    bbox: BoundingBox::standing_on(foot, 16.0, 48.0),
+                    score,
+                }
+            })
+            .collect()
+    };
+    on_candidates(params, frames, sized, seed)
+}
+
+/// Detections-only frames `0..frames` of the candidates `candidates(frame)`, particles seeded
+/// with `seed`. Returns every estimate reported.
+fn on_candidates(
+    params: &PedestrianParams,
+    frames: u64,
+    candidates: impl Fn(u64) -> Vec<Candidate>,
+    seed: u64,
+) -> Vec<PedestrianEstimate> {
     let mut tracker =
         PedestrianTracker::new(params, BoxSizing::FromCandidate, None, (W, H), seed).unwrap();
     let mut out = Vec::new();
     for frame in 0..frames {
-        let candidates: Vec<Candidate> = boxes(frame)
-            .into_iter()
-            .map(|(x, y, score)| Candidate {
-                bbox: BoundingBox::standing_on(sillage_core::Point2::new(x, y), 16.0, 48.0),
-                score,
-            })
-            .collect();
+        let candidates = candidates(frame);
         let observations = PedestrianFrame {
             frame,
             cues: None,
@@ -562,7 +579,7 @@ fn detections_alone_report_a_tracker_after_three_matches_in_a_row() {
 
 /// A walker the detector misses for 10 frames keeps its identity within `lost_frames` = 30:
 /// its tracker coasts on its velocity, unreported, and takes the detection back; with
-/// `lost_frames` = 5 (the default) the walker comes back under a new identity.
+/// `lost_frames` = 5 the walker comes back under a new identity.
 #[test]
 fn a_walker_missed_for_ten_frames_keeps_its_identity() {
     let scene = |f: u64| {
@@ -595,6 +612,43 @@ fn a_walker_missed_for_ten_frames_keeps_its_identity() {
         ..params
     };
     assert_eq!(identities(&on_detections(&short, 60, scene)).len(), 2);
+}
+
+/// A walker coming towards the camera, its box 3.5 px taller every frame, missed for 21 frames
+/// (20-40): its tracker's box keeps growing at the detections' rate while it coasts and takes
+/// the walker back (one identity, every seed); with the size frozen (`size_rate` false) the
+/// coasting box is a quarter of the returning detection's area, under the IoU gate, and the
+/// walker comes back under a new identity.
+#[test]
+fn a_walker_coming_closer_while_missed_is_taken_back_at_its_new_size() {
+    let scene = |f: u64| {
+        if (20..41).contains(&f) {
+            return Vec::new();
+        }
+        let height = 20.0 + 3.5 * f as f64;
+        let foot = sillage_core::Point2::new(150.0, 60.0 + 2.5 * f as f64);
+        let bbox = BoundingBox::standing_on(foot, height / 3.0, height);
+        vec![Candidate { bbox, score: 0.9 }]
+    };
+    let params = PedestrianParams::default();
+    assert!(params.detection.size_rate && params.detection.lost_frames > 21);
+    let mut frozen = params.clone();
+    frozen.detection.size_rate = false;
+    for seed in 1..=3 {
+        let out = on_candidates(&params, 50, scene, seed);
+        assert_eq!(
+            identities(&out).len(),
+            1,
+            "seed {seed}: {:?}",
+            identities(&out)
+        );
+        assert!(
+            out.iter().any(|e| e.frame == 49),
+            "seed {seed}: reported again"
+        );
+        let out = on_candidates(&frozen, 50, scene, seed);
+        assert_eq!(identities(&out).len(), 2, "seed {seed}, frozen size");
+    }
 }
 
 /// Weak detections (score below `high_score`) hold a tracker a detection held in the

@@ -77,6 +77,8 @@ struct Track {
     appearance: Option<Appearance>,
     /// Width and height, px, used where the sizing has no ground plane.
     size_px: (f64, f64),
+    /// Rate of change of width and height, px/frame (detections-only mode).
+    size_rate: (f64, f64),
     low_frames: u32,
     /// Consecutive frames without a candidate on the tracker's box (on detections alone:
     /// without a matched detection).
@@ -91,8 +93,8 @@ struct Track {
     /// Reported on the frames a detection holds it (detections-only mode): confirmed, and
     /// not re-confirming after a miss (`detection.reconfirm_after_loss`).
     reported: bool,
-    /// The frame and foot point of its last matched detection (detections-only mode).
-    last_detection: Option<(FrameIndex, Point2)>,
+    /// The frame and box of its last matched detection (detections-only mode).
+    last_detection: Option<(FrameIndex, BoundingBox)>,
     /// The velocity of its detections, smoothed over the streak, px/frame
     /// (detections-only mode, `detection.velocity_proposal`).
     detection_velocity: Option<Vec2>,
@@ -514,6 +516,7 @@ impl PedestrianTracker {
             filter: self.spec.spawn(track_id, &spread),
             appearance,
             size_px: (person.width_px, person.height_px),
+            size_rate: (0.0, 0.0),
             low_frames: 0,
             unsupported_frames: 0,
             matched: None,

@@ -12,7 +12,7 @@
 //! on the frames a detection holds it.
 
 use rayon::prelude::*;
-use sillage_core::{BoundingBox, FrameIndex, Point2};
+use sillage_core::{BoundingBox, FrameIndex};
 
 use super::{Candidate, PedestrianEstimate, PedestrianTracker, Track, estimate_foot, estimate_of};
 use crate::bytetrack::assign;
@@ -38,9 +38,16 @@ impl PedestrianTracker {
         out: &mut Vec<PedestrianEstimate>,
     ) {
         let models = &self.models;
-        self.tracks
-            .par_iter_mut()
-            .for_each(|track| track.filter.predict(models));
+        let size_rate = self.params.detection.size_rate;
+        self.tracks.par_iter_mut().for_each(|track| {
+            track.filter.predict(models);
+            if size_rate {
+                // As SORT's Kalman filter carries its area rate through misses; a size stays
+                // at least a pixel (SORT zeroes a rate that would make the area negative).
+                track.size_px.0 = (track.size_px.0 + track.size_rate.0).max(1.0);
+                track.size_px.1 = (track.size_px.1 + track.size_rate.1).max(1.0);
+            }
+        });
         let looks: Vec<Option<Appearance>> = match cues {
             Some(cues) if self.params.detection.colour_weight > 0.0 => candidates
                 .par_iter()
@@ -58,7 +65,7 @@ impl PedestrianTracker {
             let mut track = self.spawn(self.next_id - 1, &candidate.bbox, look, 0);
             track.matched = Some(candidate.bbox);
             track.hit_streak = 1;
-            track.last_detection = Some((frame, candidate.bbox.foot()));
+            track.last_detection = Some((frame, candidate.bbox));
             self.tracks.push(track);
         }
         self.report_on_detections(frame, out);
@@ -165,8 +172,9 @@ impl PedestrianTracker {
                         reference.adapt(appearance_params, cues, &detection, scratch);
                     }
                     let foot = detection.foot();
+                    follow_size_rate(track, &detection, frame, params.velocity_smoothing);
                     let sigma = (params.foot_sigma_fraction * detection.height_px).max(1.0);
-                    propose_on_detection(track, foot, sigma, frame, params);
+                    propose_on_detection(track, &detection, sigma, frame, params);
                     let scale = 0.5 / (sigma * sigma);
                     track
                         .filter
@@ -245,18 +253,19 @@ impl PedestrianTracker {
 /// then smooths it.
 fn propose_on_detection(
     track: &mut Track,
-    foot: Point2,
+    detection: &BoundingBox,
     sigma: f64,
     frame: FrameIndex,
     params: &DetectionLikelihoodParams,
 ) {
     let share = params.proposal_share;
+    let foot = detection.foot();
     let measured = track
         .last_detection
         .filter(|_| params.velocity_proposal)
         .map(|(then, before)| {
             let elapsed = (frame - then) as f64;
-            ((foot - before) / elapsed, elapsed)
+            ((foot - before.foot()) / elapsed, elapsed)
         });
     match measured {
         Some((velocity, elapsed)) => {
@@ -274,7 +283,27 @@ fn propose_on_detection(
         }
         None => track.filter.propose_near(share, foot, sigma),
     }
-    track.last_detection = Some((frame, foot));
+    track.last_detection = Some((frame, *detection));
+}
+
+/// Updates a matched tracker's size rate (`Track::size_rate`, px/frame) with `detection`: the
+/// change of width and height since its last detection per frame, smoothed exponentially
+/// (newest weight `smoothing`) from zero at its birth. Call before [`propose_on_detection`],
+/// which records `detection` as the last one.
+fn follow_size_rate(track: &mut Track, detection: &BoundingBox, frame: FrameIndex, smoothing: f64) {
+    let Some((then, seen)) = track.last_detection else {
+        return;
+    };
+    let elapsed = (frame - then) as f64;
+    let measured = (
+        (detection.width_px - seen.width_px) / elapsed,
+        (detection.height_px - seen.height_px) / elapsed,
+    );
+    let (w, h) = track.size_rate;
+    track.size_rate = (
+        w + smoothing * (measured.0 - w),
+        h + smoothing * (measured.1 - h),
+    );
 }
 
 /// The candidates of one frame with their colour histograms (`None` without frames).
