@@ -34,6 +34,29 @@ const AUTO_VOTE_FIRST_MAX_PX: f64 = 64.0;
 /// whose centripetal lag they leave uncorrected (recall 0.883, 0.866, 0.844).
 const VOTE_MIN_CORRECTION_SPACINGS: f64 = 0.0625;
 
+/// While the motion model predicts, a vote searches this many times the largest correction
+/// the previous vote made to the model's displacements, at least [`VOTE_REACH_MIN_PX`], instead
+/// of the whole decided radius: the model is usually right to a pixel or two, and the pairs a
+/// vote weighs grow with the square of its radius (on 25,000 particles moving up to 10 px per
+/// frame, corrections of at most 1.1–1.9 px under a decided radius of 19.5 px).
+const VOTE_REACH_CORRECTIONS: f64 = 4.0;
+/// The least radius of such a vote, px.
+const VOTE_REACH_MIN_PX: f64 = 4.0;
+
+/// The next vote's search radius after a vote within `radius` (the decided one `search_px`)
+/// corrected the model's displacements `prior` into `voted`: [`VOTE_REACH_CORRECTIONS`] times
+/// the largest correction, or `None` (the decided radius) when a correction reached half of
+/// `radius`, where the model may have fallen behind the flow by more than the vote saw.
+fn next_vote_reach(voted: &[Vec2], prior: &[Vec2], radius: f64, search_px: f64) -> Option<f64> {
+    let largest = voted
+        .iter()
+        .zip(prior)
+        .map(|(&v, &p)| (v - p).norm())
+        .fold(0.0, f64::max);
+    let reach = (VOTE_REACH_CORRECTIONS * largest).max(VOTE_REACH_MIN_PX);
+    (largest < 0.5 * radius && reach < search_px).then_some(reach)
+}
+
 /// Fewest points a rayon task handles in the per-point loops (keeps task overhead small).
 const PAR_MIN_LEN: usize = 1024;
 
@@ -140,6 +163,10 @@ pub struct PtvTracker {
     /// automatic decision waits for the first two frames.
     vote_radius: Option<f64>,
     vote_decided: bool,
+    /// The next vote's search radius while the model predicts ([`next_vote_reach`]): `None`
+    /// searches the whole `vote_radius`.
+    #[serde(default)]
+    vote_reach: Option<f64>,
     /// An automatic decision taken elsewhere that this tracker follows (a time window of a
     /// longer run: `Some(radius)`, or `None` for off), see [`PtvTracker::follow_vote_decision`].
     #[serde(default)]
@@ -199,6 +226,7 @@ impl PtvTracker {
                 VoteSearch::Mode(_) => None,
             },
             vote_decided: vote != VoteSearch::Mode(VoteMode::Auto),
+            vote_reach: None,
             followed_decision: None,
             measured_displacement: None,
             measured_valid_share: None,
@@ -406,15 +434,25 @@ impl PtvTracker {
         self.displacements.clear();
         self.displacements
             .extend(self.vel_pred.iter().map(|&u| u * dt));
+        let radius = match self.vote_reach {
+            Some(reach) if model_applied => reach.min(search_px),
+            _ => search_px,
+        };
         let mut voted = std::mem::take(&mut self.voted);
         let vote = voted_displacements(
             &self.c1,
             &self.c2,
             Some(&self.displacements),
-            search_px,
+            radius,
             &mut voted,
         );
         self.voted = voted;
+        self.vote_reach = match &vote {
+            Some(_) if model_applied => {
+                next_vote_reach(&self.voted, &self.displacements, radius, search_px)
+            }
+            _ => None,
+        };
         if let Some(vote) = vote {
             self.apply_votes(&vote, model_applied, dt);
         }
@@ -746,6 +784,31 @@ impl Tracker for PtvTracker {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_next_vote_searches_four_times_the_largest_correction_until_one_reaches_half_its_radius()
+    {
+        let prior = vec![Vec2::new(3.0, 0.0); 3];
+        let voted = |dx: f64| {
+            vec![
+                Vec2::new(3.0, 0.0),
+                Vec2::new(3.0 + dx, 0.0),
+                Vec2::new(3.0, 0.5),
+            ]
+        };
+        let reach = next_vote_reach(&voted(1.5), &prior, 19.5, 19.5).unwrap();
+        assert!((reach - 6.0).abs() < 1e-12, "{reach}");
+        // Never below the floor, never the decided radius itself.
+        assert_eq!(
+            next_vote_reach(&voted(0.1), &prior, 19.5, 19.5),
+            Some(VOTE_REACH_MIN_PX)
+        );
+        assert_eq!(next_vote_reach(&voted(5.0), &prior, 19.5, 19.5), None);
+        // A correction at half the searched radius: the model may have fallen behind by more
+        // than the vote could see, so the next vote searches the decided radius again.
+        assert_eq!(next_vote_reach(&voted(3.0), &prior, 6.0, 19.5), None);
+        assert!(next_vote_reach(&voted(2.9), &prior, 6.0, 19.5).is_some());
+    }
     use rand::RngExt;
     use sillage_core::rng_stream;
 
