@@ -574,6 +574,9 @@ fn training_passes_track_at_least_as_much_as_one_pass() {
     assert!(r3 >= r1);
 }
 
+/// A uniform flow's total displacement at time `t`, px.
+type Shift = fn(f64) -> Vec2;
+
 #[test]
 fn tracking_resumes_after_the_flow_suddenly_changes() {
     // 400 particles on a 20 px lattice translating uniformly; at frame 10 the flow changes at
@@ -582,7 +585,7 @@ fn tracking_resumes_after_the_flow_suddenly_changes() {
     // the model never learned the new motion, and no particle was tracked from the change's
     // fourth frame on (recall 0.46–0.47 with the defaults in every case); now such a frame
     // restarts the test.
-    let changes: [(&str, fn(f64) -> Vec2); 5] = [
+    let changes: [(&str, Shift); 5] = [
         ("speeds up 2 → 8 px", |t| {
             Vec2::new(2.0 * t.min(10.0) + 8.0 * (t - 10.0).max(0.0), 0.0)
         }),
