@@ -887,6 +887,8 @@ impl Tracker for PtvTracker {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::RngExt;
+    use sillage_core::rng_stream;
 
     #[test]
     fn the_next_vote_searches_four_times_the_largest_correction_until_one_reaches_half_its_radius()
@@ -912,8 +914,6 @@ mod tests {
         assert_eq!(next_vote_reach(&voted(3.0), &prior, 6.0, 19.5), None);
         assert!(next_vote_reach(&voted(2.9), &prior, 6.0, 19.5).is_some());
     }
-    use rand::RngExt;
-    use sillage_core::rng_stream;
 
     #[test]
     fn radix_sort_by_track_id_matches_a_comparison_sort() {
