@@ -206,10 +206,15 @@ def test_ptv_iter_streams_what_ptv_returns(vortex, tmp_path):
     frames, _ = vortex
     whole = sillage.ptv(frames, motion_av=5)
     steps = list(sillage.ptv_iter(iter(frames), motion_av=5))
-    assert len(steps) == len(frames)
-    assert len(steps[0]) == 0 and set(steps[2].frame) == {1}
+    # Velocities fitted over 7 frames: frame 1 leaves at frame 4, the last ones at the end.
+    assert len(steps) == len(frames) + 1
+    assert all(len(s) == 0 for s in steps[:4]) and set(steps[4].frame) == {1}
     streamed = pd.concat(steps, ignore_index=True)
     pd.testing.assert_frame_equal(streamed, whole, check_dtype=False)
+    # With TracTrac's three-frame velocities, frame t-1 leaves as soon as frame t is seen.
+    steps = list(sillage.ptv_iter(iter(frames), motion_av=5, velocity_window=3))
+    assert len(steps) == len(frames)
+    assert len(steps[0]) == 0 and set(steps[2].frame) == {1}
     with pytest.raises(ValueError, match="training_passes"):
         list(sillage.ptv_iter(frames, training_passes=1))
     with pytest.raises(ValueError, match="same shape"):

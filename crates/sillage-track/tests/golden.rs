@@ -100,13 +100,23 @@ fn track(frames: &[Vec<Detection>], params: PtvParams, passes: usize) -> Vec<Tra
 #[test]
 fn output_on_fixed_scenes_is_unchanged() {
     let frames = scene(5_000, 30);
-    // TracTrac's algorithm (no voting), as recorded; the automatic voting decision is tested
-    // in `ptv.rs`.
+    // TracTrac's algorithm (no voting, Eq. 6 velocities), as recorded; the automatic voting
+    // decision is tested in `ptv.rs`.
     let tractrac = PtvParams {
         vote_search_px: VoteSearch::OFF,
+        velocity_window: 3,
         ..Default::default()
     };
     let default = track(&frames, tractrac.clone(), 1);
+    // The same with velocities fitted along the trajectories (the default window).
+    let fitted = track(
+        &frames,
+        PtvParams {
+            velocity_window: PtvParams::default().velocity_window,
+            ..tractrac.clone()
+        },
+        1,
+    );
     let iterated = track(
         &frames,
         PtvParams {
@@ -121,6 +131,7 @@ fn output_on_fixed_scenes_is_unchanged() {
     let got = [
         (default.len(), fingerprint(&default)),
         (iterated.len(), fingerprint(&iterated)),
+        (fitted.len(), fingerprint(&fitted)),
     ];
     println!("{got:?}");
     assert!(default.len() > 100_000);
@@ -130,8 +141,10 @@ fn output_on_fixed_scenes_is_unchanged() {
 /// (points emitted, fingerprint), recorded with the implementation before the optimisation;
 /// re-pinned on 2026-11-29 when rejected tracklets that move together with the rejected ones
 /// around them started to be kept (`keep_coherent_changes`): 116,882 → 116,883 and 116,088 →
-/// 116,093 points.
-const EXPECTED: [(usize, u64); 2] = [
+/// 116,093 points. The third, velocities fitted over seven frames (`velocity_window`), added
+/// on 2026-11-29 with that parameter; the first two, Eq. 6 velocities, did not change.
+const EXPECTED: [(usize, u64); 3] = [
     (116_883, 11_821_194_333_032_774_850),
     (116_093, 15_184_758_575_767_044_285),
+    (116_883, 2_148_475_952_227_226_248),
 ];

@@ -177,8 +177,10 @@ def ptv_iter(frames: Iterable[np.ndarray] | str, *,
     ``frames`` is a path (as for :func:`ptv`) or any iterable of 2-D arrays (a pims
     sequence, a generator): only a few frames are ever held in memory. After each frame it
     yields the track points that became final, in the columns of :func:`ptv` (frame t-1's
-    points once frame t is seen; so the DataFrames of all steps, concatenated, equal what
-    :func:`ptv` returns). Keywords as for :func:`ptv`; ``training_passes`` must stay 0.
+    points once frame t + ``velocity_window`` // 2 - 1 is seen, frame t+2 with the default
+    window of 7 frames; the rest after the last frame), so the DataFrames of all steps,
+    concatenated, equal what :func:`ptv` returns. Keywords as for :func:`ptv`;
+    ``training_passes`` must stay 0.
 
     >>> for points in sillage.ptv_iter("long_run/*.tif", scale_px=2.5):
     ...     update_statistics(points)

@@ -8,7 +8,9 @@
 //! 3. makes a tracklet of every point of frame t−1 paired both backwards (t−2 ↔ t−1) and
 //!    forwards (t−1 ↔ t), with central-difference kinematics (Eqs. 6–7);
 //! 4. rejects tracklets whose log prediction error is an outlier (Eqs. 10–12);
-//! 5. hands track ids over from link to link (§3.1.4) and emits frame t−1.
+//! 5. hands track ids over from link to link (§3.1.4) and emits frame t−1, its velocities
+//!    fitted along each trajectory over `velocity_window` frames (see `smoothing`; 3 is
+//!    TracTrac's Eq. 6), which holds points back `velocity_window / 2 − 1` frames.
 //!
 //! It follows what TracTrac's Python code does where it differs from the paper's text; each
 //! function says where. Training passes (TracTrac's `vid_loop`) are driven by the caller
@@ -17,11 +19,13 @@
 mod filter;
 mod motion;
 mod params;
+mod smoothing;
 mod tracker;
 mod voting;
 
 pub use params::{
     AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_MIN_VALID_SHARE, AUTO_VOTE_SPACINGS,
-    AUTO_VOTE_UNRESOLVED_SPACINGS, PtvParams, VoteMode, VoteSearch,
+    AUTO_VOTE_UNRESOLVED_SPACINGS, DEFAULT_VELOCITY_WINDOW, MAX_VELOCITY_WINDOW, PtvParams,
+    VoteMode, VoteSearch,
 };
 pub use tracker::{PassDirection, PtvTracker};

@@ -13,6 +13,7 @@ use super::params::{
     AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_MIN_VALID_SHARE, AUTO_VOTE_SPACINGS,
     AUTO_VOTE_UNRESOLVED_SPACINGS, PtvParams, VoteMode, VoteSearch,
 };
+use super::smoothing::{Linked, StepFrames, VelocitySmoother};
 use super::voting::{Vote, mean_spacing, voted_displacements};
 
 /// The automatic vote's first search radius, in mean spacings, and its smallest value in px.
@@ -130,14 +131,15 @@ struct Triplet {
     kept: bool,
 }
 
-/// TracTrac's tracker (see the [module docs](super)): emits the points of frame t−1 at the
-/// step of frame t, in increasing track id order, with the central-difference velocity
-/// (Eq. 6), the acceleration (Eq. 7), the motion-model velocity (Eq. 8) and the log10
+/// TracTrac's tracker (see the [module docs](super)): emits the points of frame t−1, in
+/// increasing track id order, with the velocity fitted along the trajectory over
+/// `velocity_window` frames (Eq. 6 with 3, at the step of frame t; with more, `window / 2 − 1`
+/// steps later), the acceleration (Eq. 7), the motion-model velocity (Eq. 8) and the log10
 /// prediction error (Eq. 10).
 ///
-/// `finish` has nothing to flush: the first and the last frame of a pass are never the
-/// middle of a triplet (TracTrac also outputs frames 1..n−2 only), and every other frame
-/// was emitted as soon as its successor arrived.
+/// `finish` hands out the frames still held for their velocity windows. The first and the
+/// last frame of a pass are never the middle of a triplet (TracTrac also outputs frames
+/// 1..n−2 only).
 ///
 /// Training passes: [`PtvTracker::start_pass`] starts a new pass over the same sequence,
 /// keeping the motion model and the outlier threshold. The caller (the facade) drives them,
@@ -217,9 +219,23 @@ pub struct PtvTracker {
     ids1: Vec<Option<TrackId>>,
     /// (track id, triplet) of the points to emit, sorted into the emission order.
     emit_order: Vec<(TrackId, usize)>,
-    /// Scratch of the radix sort of `emit_order`.
+    /// (track id, triplet) of the rejected tracklets that carry an id, for the velocity fit.
+    #[serde(skip)]
+    carry_order: Vec<(TrackId, usize)>,
+    /// Scratch of the radix sorts of `emit_order` and `carry_order`.
     emit_scratch: Vec<(TrackId, usize)>,
     emitted: Vec<TrackPoint>,
+    /// Fits the emitted points' velocities along their trajectories, holding them until
+    /// their windows are complete (absent from older checkpoints: Eq. 6 velocities). Boxed:
+    /// its buffers would make the tracker the one large variant of the facade's tracker enum.
+    #[serde(default)]
+    smoother: Box<VelocitySmoother>,
+    /// The positions of the emitted points' trajectories and of the rejected tracklets'
+    /// carrying an id, around frame t−1.
+    #[serde(skip)]
+    linked: Vec<Linked>,
+    #[serde(skip)]
+    carried: Vec<Linked>,
 }
 
 impl PtvTracker {
@@ -227,6 +243,7 @@ impl PtvTracker {
     pub fn new(params: PtvParams) -> Result<Self> {
         params.validate()?;
         let vote = params.vote_search_px;
+        let smoother = Box::new(VelocitySmoother::new(params.velocity_window, params.dt));
         Ok(Self {
             field: MotionField::new(params.motion_av, params.filter_time),
             params,
@@ -270,10 +287,14 @@ impl PtvTracker {
             errors: Vec::new(),
             ids1: Vec::new(),
             emit_order: Vec::new(),
+            carry_order: Vec::new(),
             emit_scratch: Vec::new(),
             rejected_at: Vec::new(),
             velocity_at: Vec::new(),
             emitted: Vec::new(),
+            smoother,
+            linked: Vec::new(),
+            carried: Vec::new(),
         })
     }
 
@@ -315,6 +336,8 @@ impl PtvTracker {
         self.direction = direction;
         self.frames_in_pass = 0;
         self.next_id = 0;
+        self.smoother
+            .start_pass(direction == PassDirection::Forward);
     }
 
     /// The time step of this pass, negative when going backwards.
@@ -711,15 +734,18 @@ impl PtvTracker {
     }
 
     /// §3.1.4: each tracklet takes the id of its t−2 ↔ t−1 link; kept tracklets without one
-    /// get a new id; rejected ones still pass an inherited id on. Emits the kept ones.
-    ///
+    /// get a new id; rejected ones still pass an inherited id on. Emits the kept ones, to the
+    /// velocity fit with the positions of every tracklet carrying an id ([`Self::link`];
+    /// frame t is `frame_c2`).
     ///
     /// The points are put in id order through (id, triplet) keys rather than by sorting the
     /// points themselves (16-byte keys instead of whole track points), then built in parallel.
-    fn hand_over_ids(&mut self, sink: &mut dyn TrackSink) -> Result<()> {
+    fn hand_over_ids(&mut self, frame_c2: FrameIndex, sink: &mut dyn TrackSink) -> Result<()> {
+        let fits = !self.smoother.passes_through();
         self.ids1.clear();
         self.ids1.resize(self.c1.len(), None);
         self.emit_order.clear();
+        self.carry_order.clear();
         for (n, t) in self.triplets.iter().enumerate() {
             let mut id = self.ids0[t.before];
             if id.is_none() && t.kept {
@@ -727,8 +753,10 @@ impl PtvTracker {
                 self.next_id += 1;
             }
             self.ids1[t.middle] = id;
-            if let (Some(track_id), true) = (id, t.kept) {
-                self.emit_order.push((track_id, n));
+            match (id, t.kept) {
+                (Some(track_id), true) => self.emit_order.push((track_id, n)),
+                (Some(track_id), false) if fits => self.carry_order.push((track_id, n)),
+                _ => {}
             }
         }
         sort_by_track_id(&mut self.emit_order, &mut self.emit_scratch);
@@ -749,11 +777,47 @@ impl PtvTracker {
                 }
             })
             .collect_into_vec(&mut self.emitted);
-        if self.emitted.is_empty() {
-            Ok(())
-        } else {
-            sink.accept(&self.emitted)
+        let frames = StepFrames {
+            before: match self.direction {
+                PassDirection::Forward => frame.saturating_sub(self.gap_c1),
+                PassDirection::Backward => frame + self.gap_c1,
+            },
+            at: frame,
+            after: frame_c2,
+        };
+        if fits {
+            sort_by_track_id(&mut self.carry_order, &mut self.emit_scratch);
+            let (mut linked, mut carried) = (
+                std::mem::take(&mut self.linked),
+                std::mem::take(&mut self.carried),
+            );
+            self.link(&self.emit_order, &mut linked);
+            self.link(&self.carry_order, &mut carried);
+            (self.linked, self.carried) = (linked, carried);
         }
+        self.smoother.push(
+            frames,
+            &mut self.emitted,
+            &[&self.linked, &self.carried],
+            sink,
+        )
+    }
+
+    /// The three positions (frames t−2, t−1, t) of the tracklets `order` names, for the
+    /// velocity fit, into `linked`.
+    fn link(&self, order: &[(TrackId, usize)], linked: &mut Vec<Linked>) {
+        let (triplets, c0, c1, c2) = (&self.triplets, &self.c0, &self.c1, &self.c2);
+        order
+            .par_iter()
+            .with_min_len(PAR_MIN_LEN)
+            .map(|&(id, n)| {
+                let t = &triplets[n];
+                Linked {
+                    id,
+                    positions: [c0[t.before], c1[t.middle], c2[t.after]],
+                }
+            })
+            .collect_into_vec(linked);
     }
 
     /// Frame t (`gap` frames after t−1) becomes t−1: rotates positions, indexes, links and
@@ -870,7 +934,7 @@ impl Tracker for PtvTracker {
                 if model_updated {
                     std::mem::swap(&mut self.stored, &mut self.next_stored);
                 }
-                self.hand_over_ids(sink)?;
+                self.hand_over_ids(obs.frame, sink)?;
                 std::mem::swap(&mut self.recent, &mut self.current);
                 self.shift(obs.frame, gap);
             }
@@ -879,8 +943,8 @@ impl Tracker for PtvTracker {
         Ok(())
     }
 
-    fn finish(&mut self, _sink: &mut dyn TrackSink) -> Result<()> {
-        Ok(())
+    fn finish(&mut self, sink: &mut dyn TrackSink) -> Result<()> {
+        self.smoother.flush(sink)
     }
 }
 
