@@ -12,10 +12,11 @@
 //! A line through a curved path is biased: a point turning by ω per frame gets
 //! `Σₖ k sin kω / (ω Σₖ k²)` of its speed from seven frames, 0.74 at ω = 0.5 rad, where Eq. 6
 //! gets `sin ω / ω` = 0.96. So each point's window is chosen by Lepski's rule: the widest
-//! whose slope agrees with the slope of every narrower window within [`AGREEMENT_SIGMAS`]
-//! standard deviations of their difference. That needs the positions' noise σ, which the
-//! trajectories themselves give: the fourth difference of five positions cancels any cubic
-//! path and leaves noise of variance 70σ² per axis; σ is measured per frame from its median.
+//! whose slope agrees with the slope of every narrower window, their difference within
+//! [`AGREEMENT_SIGMAS`] times its root-mean-square length under noise alone. That needs the
+//! positions' noise σ, which the trajectories themselves give: the fourth difference of five
+//! positions cancels any cubic path and leaves noise of variance 70σ² per axis; σ is measured
+//! per frame from its median.
 //!
 //! The fit needs the positions up to `h` frames ahead, so a point leaves `h − 1` frames later
 //! than it would with Eq. 6; [`VelocitySmoother::flush`] hands out the rest at the end.
@@ -32,13 +33,14 @@ const PAR_MIN_LEN: usize = 1024;
 /// Widest half-window, frames on each side (`MAX_VELOCITY_WINDOW / 2`).
 const MAX_HALF: usize = crate::ptv::MAX_VELOCITY_WINDOW / 2;
 
-/// Lepski's rule: a wider window's slope must lie within this many standard deviations of
-/// every narrower window's (the difference of two nested slopes has the variance
-/// `σ² (1/Σ_ρ − 1/Σ_r)` per axis, `Σ_r = Σ_{k ≤ r} k²`). A three-sigma test, which noise
-/// alone fails once in ≈ 90 comparisons (χ² of two degrees of freedom above 9), chosen
-/// before any measurement; 2 was tried on the accuracy families' tune halves and was worse on
-/// every figure (main 60.8 / 15.1 % against 61.2 / 14.6 %, median displacement error 0.055
-/// against 0.049 px per frame).
+/// Lepski's rule: the squared length of the difference between a wider window's slope and
+/// a narrower one's must stay within this factor squared of its expectation under noise
+/// alone, `σ² (1/Σ_ρ − 1/Σ_r)` over both axes (`Σ_r = Σ_{k ≤ r} k²`; nested least-squares
+/// slopes differ by the difference of their variances). With 3, noise alone fails the test
+/// once in ≈ 8,000 comparisons (χ² of two degrees of freedom above 18). Chosen before any
+/// measurement; 2 (χ² above 8, once in 55) was tried on the accuracy families' tune halves
+/// and was worse on every figure (main 60.8 / 15.1 % against 61.2 / 14.6 %, median
+/// displacement error 0.055 against 0.049 px per frame).
 pub(crate) const AGREEMENT_SIGMAS: f64 = 3.0;
 
 /// Median of χ² with one degree of freedom: a squared standard normal's median.
