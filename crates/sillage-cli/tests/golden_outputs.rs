@@ -48,11 +48,11 @@ fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
     // the automatic scale became √(0.7σ̂) instead of √(0.8σ̂) (2026-11-28), and the
     // matched-scale re-fit is refused on flat peaks (`FLAT_PEAK_SIGMAS`, 2026-11-28), and
     // later that day twins of one particle were merged and the scale became √(0.5σ̂); on
-    // 2026-11-29 velocities became fitted along the trajectories over seven frames
-    // (`tracker.velocity_window`; positions and ids unchanged).
+    // 2026-11-29 velocities and accelerations became fitted along the trajectories over up
+    // to seven frames (`tracker.velocity_window`; positions and ids unchanged).
     let expected = [
-        ("tracks_track.txt", 0xa845_6d9b_e821_30b9_u64),
-        ("tracks.csv", 0x753f_6ee9_d45b_178b),
+        ("tracks_track.txt", 0xbd35_a2fe_4b01_ac03_u64),
+        ("tracks.csv", 0x61d1_d281_ed69_c17d),
     ];
     for (name, hash) in expected {
         let out = dir.path().join(name);

@@ -119,9 +119,12 @@ pub struct TrackPoint {
     pub track_id: TrackId,
     /// Position, px.
     pub pos_px: Point2,
-    /// Velocity, px/frame (PTV: central difference, Eq. (6) of the TracTrac paper).
+    /// Velocity, px/frame (PTV: the slope of a least-squares line through up to
+    /// `tracker.velocity_window` positions of the trajectory, or the central difference of
+    /// Eq. (6) of the TracTrac paper).
     pub vel_px_per_frame: Option<Vec2>,
-    /// Acceleration, px/frame² (PTV: Eq. (7)).
+    /// Acceleration, px/frame² (PTV: twice the leading coefficient of a least-squares
+    /// parabola through those positions, or Eq. (7)).
     pub acc_px_per_frame2: Option<Vec2>,
     /// Velocity predicted by the motion model, px/frame (PTV: Eq. (8)).
     pub vel_pred_px_per_frame: Option<Vec2>,

@@ -366,7 +366,7 @@ fn noisy_translation(vel: Vec2, noise: f64) -> Scene {
 }
 
 #[test]
-fn velocities_fitted_along_trajectories_carry_far_less_position_noise() {
+fn kinematics_fitted_along_trajectories_carry_far_less_position_noise() {
     let vel = Vec2::new(1.5, -0.7);
     let scene = noisy_translation(vel, 0.3);
     let track = |velocity_window: usize| {
@@ -390,7 +390,19 @@ fn velocities_fitted_along_trajectories_carry_far_less_position_noise() {
         fitted_error < 0.5 * eq6_error,
         "Eq. 6: {eq6_error:.4} px/frame, fitted: {fitted_error:.4}"
     );
-    // Only the velocities change: the same points, ids and order.
+    let acceleration_error = |points: &[TrackPoint]| {
+        let total: f64 = points
+            .iter()
+            .map(|p| p.acc_px_per_frame2.unwrap().norm())
+            .sum();
+        total / points.len() as f64
+    };
+    let (eq7_error, parabola_error) = (acceleration_error(&eq6), acceleration_error(&fitted));
+    assert!(
+        parabola_error < 0.25 * eq7_error,
+        "Eq. 7: {eq7_error:.4} px/frame², fitted: {parabola_error:.4}"
+    );
+    // Only the kinematics change: the same points, ids and order.
     let key = |p: &TrackPoint| {
         (
             p.frame,

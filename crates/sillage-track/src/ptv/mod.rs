@@ -9,8 +9,9 @@
 //!    forwards (t−1 ↔ t), with central-difference kinematics (Eqs. 6–7);
 //! 4. rejects tracklets whose log prediction error is an outlier (Eqs. 10–12);
 //! 5. hands track ids over from link to link (§3.1.4) and emits frame t−1, its velocities
-//!    fitted along each trajectory over `velocity_window` frames (see `smoothing`; 3 is
-//!    TracTrac's Eq. 6), which holds points back `velocity_window / 2 − 1` frames.
+//!    and accelerations fitted along each trajectory over up to `velocity_window` frames
+//!    (see `smoothing`; 3 is TracTrac's Eqs. 6–7), which holds points back
+//!    `velocity_window / 2 − 1` frames.
 //!
 //! It follows what TracTrac's Python code does where it differs from the paper's text; each
 //! function says where. Training passes (TracTrac's `vid_loop`) are driven by the caller

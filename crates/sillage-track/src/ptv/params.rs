@@ -44,9 +44,10 @@ pub struct PtvParams {
     pub max_displacement_px: Option<f64>,
     /// Time between frames in the unit velocities are reported in; 1.0 gives px/frame.
     pub dt: f64,
-    /// Frames of a trajectory its reported velocity is fitted over (odd, 3 to
-    /// [`MAX_VELOCITY_WINDOW`]): the slope of the least-squares line through them, narrowed
-    /// at a trajectory's ends; 3 is TracTrac's central difference (Eq. 6). Default
+    /// Frames of a trajectory its reported velocity and acceleration are fitted over (odd, 3
+    /// to [`MAX_VELOCITY_WINDOW`]): the slope of the least-squares line and twice the leading
+    /// coefficient of the least-squares parabola through them, each window narrowed where the
+    /// path bends or the trajectory ends; 3 is TracTrac's Eqs. 6 and 7. Default
     /// [`DEFAULT_VELOCITY_WINDOW`]. Points leave the tracker `window / 2 − 1` frames later.
     pub velocity_window: usize,
 }

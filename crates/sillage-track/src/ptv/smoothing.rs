@@ -1,4 +1,4 @@
-//! Velocities fitted along trajectories.
+//! Velocities and accelerations fitted along trajectories.
 //!
 //! TracTrac reports the central difference over three frames (Eq. 6), `(x(t+1) − x(t−1)) / 2`:
 //! with positions of independent error σ per axis, its error is σ/√2. The slope of the
@@ -17,6 +17,10 @@
 //! positions' noise σ, which the trajectories themselves give: the fourth difference of five
 //! positions cancels any cubic path and leaves noise of variance 70σ² per axis; σ is measured
 //! per frame from its median.
+//!
+//! Accelerations the same way: Eq. 7's second difference has the error σ√6 per axis; twice
+//! the leading coefficient of the least-squares parabola over seven frames has σ/√21, 11
+//! times smaller, and its window is chosen by the same rule.
 //!
 //! The fit needs the positions up to `h` frames ahead, so a point leaves `h − 1` frames later
 //! than it would with Eq. 6; [`VelocitySmoother::flush`] hands out the rest at the end.
@@ -121,40 +125,79 @@ impl Around {
         Some(b2 + a2 - (b1 + a1) * 4.0)
     }
 
-    /// The slope of the widest window that Lepski's rule accepts with position variance
-    /// `noise` (px² per axis), px per frame; `None` when that is Eq. 6's three frames, or the
-    /// trajectory lacks the positions for more.
-    fn fitted(&self, ring: &[Slot], noise: f64) -> Option<Vec2> {
-        let limit = AGREEMENT_SIGMAS * AGREEMENT_SIGMAS * noise;
+    /// The velocity (the slope of a least-squares line) and the acceleration (twice the
+    /// leading coefficient of a least-squares parabola) over the widest windows Lepski's rule
+    /// accepts with position variance `noise` (px² per axis), per frame and per frame²; each
+    /// `None` where that is Eq. 6's or Eq. 7's three frames, or the trajectory lacks the
+    /// positions for more.
+    fn kinematics(&self, ring: &[Slot], noise: f64) -> (Option<Vec2>, Option<Vec2>) {
+        let Some(centre) = self.position(ring, 0) else {
+            return (None, None);
+        };
         let mut slopes = [Vec2::ZERO; MAX_HALF];
-        let (mut sum, mut chosen) = (Vec2::ZERO, None);
+        let mut accelerations = [Vec2::ZERO; MAX_HALF];
+        // Σ k (x(k) − x(−k)), Σ (x(k) + x(−k)) and Σ k² (x(k) + x(−k)), positions taken from
+        // the centre's.
+        let (mut odd, mut even, mut even_k2) = (Vec2::ZERO, Vec2::ZERO, Vec2::ZERO);
+        let mut reach = 0;
         for r in 1..=self.half {
             let k = r as i64;
             let (Some(back), Some(ahead)) = (self.position(ring, -k), self.position(ring, k))
             else {
                 break;
             };
-            sum = sum + (ahead - back) * k as f64;
-            let slope = sum * (0.5 / sum_of_squares(r));
-            let agrees = (1..r).all(|narrower| {
-                let spread = 1.0 / sum_of_squares(narrower) - 1.0 / sum_of_squares(r);
-                (slope - slopes[narrower - 1]).norm_squared() <= limit * spread
-            });
-            if !agrees {
-                break;
-            }
-            slopes[r - 1] = slope;
-            if r >= 2 {
-                chosen = Some(slope);
-            }
+            let (back, ahead) = (back - centre, ahead - centre);
+            let k = k as f64;
+            odd = odd + (ahead - back) * k;
+            even = even + (ahead + back);
+            even_k2 = even_k2 + (ahead + back) * (k * k);
+            slopes[r - 1] = odd * (0.5 / sum_of_squares(r));
+            let mean_k2 = 2.0 * sum_of_squares(r) / (2 * r + 1) as f64;
+            accelerations[r - 1] = (even_k2 - even * mean_k2) * (2.0 / parabola_spread(r));
+            reach = r;
         }
-        chosen
+        let limit = AGREEMENT_SIGMAS * AGREEMENT_SIGMAS * noise;
+        (
+            widest_agreeing(&slopes[..reach], |r| 1.0 / sum_of_squares(r), limit),
+            widest_agreeing(&accelerations[..reach], |r| 8.0 / parabola_spread(r), limit),
+        )
     }
 }
 
+/// `Σ_{k=−r}^{r} (k² − m)²`, m the mean of k² over the window: the spread of a parabola's
+/// regressor (its leading coefficient has the variance σ² over it).
+fn parabola_spread(r: usize) -> f64 {
+    let fourth_powers = (r * (r + 1) * (2 * r + 1) * (3 * r * r + 3 * r - 1)) as f64 / 30.0;
+    let squares = 2.0 * sum_of_squares(r);
+    2.0 * fourth_powers - squares * squares / (2 * r + 1) as f64
+}
+
+/// Lepski's rule over `estimates[r − 1]`, made from ±r frames: the widest `r ≥ 2` whose
+/// estimate agrees with every narrower one, the squared difference within `limit` (κ²σ²)
+/// times `variance(ρ) − variance(r)` (the estimates' variances over both axes, per σ²);
+/// `None` when none wider than ±1 does.
+fn widest_agreeing(
+    estimates: &[Vec2],
+    variance: impl Fn(usize) -> f64,
+    limit: f64,
+) -> Option<Vec2> {
+    let mut chosen = None;
+    for r in 2..=estimates.len() {
+        let agrees = (1..r).all(|narrower| {
+            let spread = variance(narrower) - variance(r);
+            (estimates[r - 1] - estimates[narrower - 1]).norm_squared() <= limit * spread
+        });
+        if !agrees {
+            break;
+        }
+        chosen = Some(estimates[r - 1]);
+    }
+    chosen
+}
+
 /// Holds each frame's points until the frames their windows need have arrived, keeping the
-/// last `2h + 1` positions of every recent trajectory, and replaces their velocities by the
-/// fitted ones (see the [module docs](self)). Trajectories are kept sorted by id, so a
+/// last `2h + 1` positions of every recent trajectory, and replaces their velocities and
+/// accelerations by the fitted ones (see the [module docs](self)). Trajectories are kept sorted by id, so a
 /// frame's positions (in increasing id order, as the tracker emits them) are recorded in one
 /// merge. Deterministic: each point's fit reads only its own trajectory, and the noise is a
 /// median.
@@ -208,7 +251,7 @@ impl VelocitySmoother {
         self.since_pruned = 0;
     }
 
-    /// Whether points go straight to the sink with their Eq. 6 velocity.
+    /// Whether points go straight to the sink with their Eq. 6 and 7 kinematics.
     pub fn passes_through(&self) -> bool {
         self.half < 2 || !self.active
     }
@@ -280,8 +323,12 @@ impl VelocitySmoother {
                 .for_each(|(p, &track)| {
                     let Some(track) = track else { return };
                     let own = &slots[track * ring..(track + 1) * ring];
-                    if let Some(slope) = around.fitted(own, noise) {
-                        p.vel_px_per_frame = Some(slope * per_time);
+                    let (velocity, acceleration) = around.kinematics(own, noise);
+                    if let Some(v) = velocity {
+                        p.vel_px_per_frame = Some(v * per_time);
+                    }
+                    if let Some(a) = acceleration {
+                        p.acc_px_per_frame2 = Some(a * (per_time * per_time));
                     }
                 });
             sink.accept(&points)?;
@@ -413,9 +460,11 @@ mod tests {
     ) -> Vec<Entry> {
         frames
             .map(|f| {
+                let (before, at, after) = (path(f - 1), path(f), path(f + 1));
                 let point = TrackPoint {
-                    vel_px_per_frame: Some((path(f + 1) - path(f - 1)) * 0.5),
-                    ..TrackPoint::at(f, id, path(f))
+                    vel_px_per_frame: Some((after - before) * 0.5),
+                    acc_px_per_frame2: Some((after - at) - (at - before)),
+                    ..TrackPoint::at(f, id, at)
                 };
                 let linked = Linked {
                     id,
@@ -482,6 +531,8 @@ mod tests {
             let v = p.vel_px_per_frame.unwrap();
             let exact = Vec2::new(3.0 + 0.5 * f as f64, -1.0);
             assert!((v - exact).norm() < 1e-9, "frame {f}: {v:?}");
+            let a = p.acc_px_per_frame2.unwrap();
+            assert!((a - Vec2::new(0.5, 0.0)).norm() < 1e-9, "frame {f}: {a:?}");
         }
     }
 
@@ -513,6 +564,34 @@ mod tests {
         };
         let (three, seven) = (error(3), error(7));
         assert!(seven < 0.5 * three, "3 frames: {three}, 7 frames: {seven}");
+    }
+
+    #[test]
+    fn noise_reaches_the_acceleration_far_less_than_with_three_frames() {
+        let accelerated: Vec<Vec<Entry>> = (0..200)
+            .map(|id| {
+                trajectory(id, 1..30, move |f| {
+                    let t = f as f64;
+                    Point2::new(
+                        10.0 + 1.5 * t + 0.05 * t * t + jitter(id, f, 0, 0.3),
+                        5.0 * id as f64 + jitter(id, f, 1, 0.3),
+                    )
+                })
+            })
+            .collect();
+        let frames = by_frame(&accelerated);
+        let error = |window: usize| {
+            let out = run(&mut VelocitySmoother::new(window, 1.0), &frames);
+            let inner: Vec<f64> = out
+                .iter()
+                .filter(|p| (5..25).contains(&p.frame))
+                .map(|p| (p.acc_px_per_frame2.unwrap() - Vec2::new(0.1, 0.0)).norm())
+                .collect();
+            inner.iter().sum::<f64>() / inner.len() as f64
+        };
+        let (three, seven) = (error(3), error(7));
+        // A parabola over seven frames: the error's deviation 11× smaller than Eq. 7's.
+        assert!(seven < 0.25 * three, "3 frames: {three}, 7 frames: {seven}");
     }
 
     #[test]
@@ -573,8 +652,11 @@ mod tests {
             let fourth = around.fourth_difference(&smoother.slots);
             assert_eq!(fourth.is_some(), expected(g) >= 2, "frame {g}");
             assert_eq!(
-                around.fitted(&smoother.slots, 1e-6),
-                (expected(g) >= 2).then_some(Vec2::new(2.0, 0.0)),
+                around.kinematics(&smoother.slots, 1e-6),
+                (
+                    (expected(g) >= 2).then_some(Vec2::new(2.0, 0.0)),
+                    (expected(g) >= 2).then_some(Vec2::ZERO)
+                ),
                 "frame {g}"
             );
         }
