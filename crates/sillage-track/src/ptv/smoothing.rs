@@ -536,13 +536,15 @@ mod tests {
         }
     }
 
-    /// 200 straight trajectories at 1.5 px per frame with ±0.3 px of noise.
-    fn noisy_straight_tracks() -> Vec<Vec<Entry>> {
+    /// 200 trajectories along x at 1.5 px per frame and `acceleration` px per frame², with
+    /// ±0.3 px of noise.
+    fn noisy_tracks(acceleration: f64) -> Vec<Vec<Entry>> {
         (0..200)
             .map(|id| {
                 trajectory(id, 1..30, move |f| {
+                    let t = f as f64;
                     Point2::new(
-                        10.0 + 1.5 * f as f64 + jitter(id, f, 0, 0.3),
+                        10.0 + 1.5 * t + 0.5 * acceleration * t * t + jitter(id, f, 0, 0.3),
                         5.0 * id as f64 + jitter(id, f, 1, 0.3),
                     )
                 })
@@ -550,46 +552,35 @@ mod tests {
             .collect()
     }
 
+    fn noisy_straight_tracks() -> Vec<Vec<Entry>> {
+        noisy_tracks(0.0)
+    }
+
+    /// The mean of `error` over the points of frames 5–24 of `frames` smoothed over
+    /// `window` frames.
+    fn mean_error(frames: &[Vec<Entry>], window: usize, error: fn(&TrackPoint) -> f64) -> f64 {
+        let out = run(&mut VelocitySmoother::new(window, 1.0), frames);
+        let inner: Vec<f64> = out
+            .iter()
+            .filter(|p| (5..25).contains(&p.frame))
+            .map(error)
+            .collect();
+        inner.iter().sum::<f64>() / inner.len() as f64
+    }
+
     #[test]
     fn noise_on_the_positions_reaches_the_velocity_far_less_than_with_three_frames() {
         let frames = by_frame(&noisy_straight_tracks());
-        let error = |window: usize| {
-            let out = run(&mut VelocitySmoother::new(window, 1.0), &frames);
-            let inner: Vec<f64> = out
-                .iter()
-                .filter(|p| (5..25).contains(&p.frame))
-                .map(|p| (p.vel_px_per_frame.unwrap() - Vec2::new(1.5, 0.0)).norm())
-                .collect();
-            inner.iter().sum::<f64>() / inner.len() as f64
-        };
-        let (three, seven) = (error(3), error(7));
+        let error = |p: &TrackPoint| (p.vel_px_per_frame.unwrap() - Vec2::new(1.5, 0.0)).norm();
+        let (three, seven) = (mean_error(&frames, 3, error), mean_error(&frames, 7, error));
         assert!(seven < 0.5 * three, "3 frames: {three}, 7 frames: {seven}");
     }
 
     #[test]
     fn noise_reaches_the_acceleration_far_less_than_with_three_frames() {
-        let accelerated: Vec<Vec<Entry>> = (0..200)
-            .map(|id| {
-                trajectory(id, 1..30, move |f| {
-                    let t = f as f64;
-                    Point2::new(
-                        10.0 + 1.5 * t + 0.05 * t * t + jitter(id, f, 0, 0.3),
-                        5.0 * id as f64 + jitter(id, f, 1, 0.3),
-                    )
-                })
-            })
-            .collect();
-        let frames = by_frame(&accelerated);
-        let error = |window: usize| {
-            let out = run(&mut VelocitySmoother::new(window, 1.0), &frames);
-            let inner: Vec<f64> = out
-                .iter()
-                .filter(|p| (5..25).contains(&p.frame))
-                .map(|p| (p.acc_px_per_frame2.unwrap() - Vec2::new(0.1, 0.0)).norm())
-                .collect();
-            inner.iter().sum::<f64>() / inner.len() as f64
-        };
-        let (three, seven) = (error(3), error(7));
+        let frames = by_frame(&noisy_tracks(0.1));
+        let error = |p: &TrackPoint| (p.acc_px_per_frame2.unwrap() - Vec2::new(0.1, 0.0)).norm();
+        let (three, seven) = (mean_error(&frames, 3, error), mean_error(&frames, 7, error));
         // A parabola over seven frames: the error's deviation 11× smaller than Eq. 7's.
         assert!(seven < 0.25 * three, "3 frames: {three}, 7 frames: {seven}");
     }
