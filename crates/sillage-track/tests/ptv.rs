@@ -673,27 +673,26 @@ fn tracking_resumes_after_the_flow_suddenly_changes() {
         }),
     ];
     for (name, shift) in changes {
-        let scene = Scene::new(
-            8,
-            400,
-            20,
-            jittered_lattice(20.0),
-            |p, t| p + shift(t),
-            1.0,
-            0,
-        );
-        let points = scene.track(PtvParams::default());
-        let (recall, precision) = scene.link_scores(&points);
-        eprintln!("{name}: recall {recall:.3}, precision {precision:.4}");
-        assert!(recall > 0.95, "{name}: recall {recall}");
-        assert!(precision > 0.99, "{name}: precision {precision}");
-        let last = (scene.frames.len() - 2) as u64;
-        let tracked = points.iter().filter(|p| p.frame == last).count();
+        let tracked = track_changing_lattice(name, |p, t| p + shift(t));
         assert!(
             tracked > 390,
             "{name}: {tracked} particles tracked in the last frame"
         );
     }
+}
+
+/// Tracks 400 particles of a jittered 20 px lattice moving along `path` over 20 frames with the
+/// defaults, asserts link recall > 0.95 and precision > 0.99, and returns how many particles
+/// are tracked in the last frame the tracker emits (the one before the sequence's last).
+fn track_changing_lattice(name: &str, path: impl Fn(Point2, f64) -> Point2) -> usize {
+    let scene = Scene::new(8, 400, 20, jittered_lattice(20.0), path, 1.0, 0);
+    let points = scene.track(PtvParams::default());
+    let (recall, precision) = scene.link_scores(&points);
+    eprintln!("{name}: recall {recall:.3}, precision {precision:.4}");
+    assert!(recall > 0.95, "{name}: recall {recall}");
+    assert!(precision > 0.99, "{name}: precision {precision}");
+    let last = (scene.frames.len() - 2) as u64;
+    points.iter().filter(|p| p.frame == last).count()
 }
 
 #[test]
@@ -703,23 +702,12 @@ fn tracking_resumes_where_a_band_of_the_flow_suddenly_changes() {
     // model, so the frame-wide restart does not fire: the band was never tracked again
     // (recall 0.83 with it alone); its tracklets, rejected together and moving together, are
     // now kept.
-    let scene = Scene::new(
-        8,
-        400,
-        20,
-        jittered_lattice(20.0),
-        |p, t| {
-            let fast = if p.x < 120.0 { 8.0 } else { 2.0 };
-            p + Vec2::new(2.0 * t.min(10.0) + fast * (t - 10.0).max(0.0), 0.0)
-        },
-        1.0,
-        0,
+    let tracked = track_changing_lattice("band", |p, t| {
+        let fast = if p.x < 120.0 { 8.0 } else { 2.0 };
+        p + Vec2::new(2.0 * t.min(10.0) + fast * (t - 10.0).max(0.0), 0.0)
+    });
+    assert!(
+        tracked > 360,
+        "{tracked} particles tracked in the last frame"
     );
-    let points = scene.track(PtvParams::default());
-    let (recall, precision) = scene.link_scores(&points);
-    eprintln!("recall {recall:.3}, precision {precision:.4}");
-    assert!(recall > 0.95, "{recall}");
-    assert!(precision > 0.99, "{precision}");
-    let last = (scene.frames.len() - 2) as u64;
-    assert!(points.iter().filter(|p| p.frame == last).count() > 360);
 }
