@@ -177,7 +177,7 @@ impl Around {
                 .into_iter()
                 .find_map(|k| self.position(ring, k).map(|p| (k, p)));
             if let Some((k, p)) = further {
-                let mut window = OneSided::symmetric(reach, odd, even, even_k2);
+                let mut window = OneSided::from_centred(reach, odd, even, even_k2);
                 window.add(k as f64, p - centre);
                 velocities.push(window.slope(), window.slope_variance());
                 accelerations.push(window.acceleration(), window.acceleration_variance());
@@ -239,20 +239,20 @@ struct OneSided {
 
 impl OneSided {
     /// The moments of the centred window ±`r` from its sums (see [`Around::kinematics`]).
-    fn symmetric(r: usize, odd: Vec2, even: Vec2, even_k2: Vec2) -> Self {
-        let fourth_powers = (r * (r + 1) * (2 * r + 1) * (3 * r * r + 3 * r - 1)) as f64 / 15.0;
+    fn from_centred(r: usize, odd: Vec2, even: Vec2, even_k2: Vec2) -> Self {
         Self {
             k: [
                 (2 * r + 1) as f64,
                 0.0,
                 2.0 * sum_of_squares(r),
                 0.0,
-                fourth_powers,
+                2.0 * sum_of_fourth_powers(r),
             ],
             y: [even, odd, even_k2],
         }
     }
 
+    /// Adds the position `y` at offset `k`.
     fn add(&mut self, k: f64, y: Vec2) {
         let mut power = 1.0;
         for (j, moment) in self.k.iter_mut().enumerate() {
@@ -269,6 +269,7 @@ impl OneSided {
         self.k[0] * self.k[2] - self.k[1] * self.k[1]
     }
 
+    /// The least-squares line's slope.
     fn slope(&self) -> Vec2 {
         (self.y[1] * self.k[0] - self.y[0] * self.k[1]) * (1.0 / self.line_spread())
     }
@@ -298,12 +299,16 @@ impl OneSided {
     }
 }
 
+/// `Σ_{k=1}^{r} k⁴`.
+fn sum_of_fourth_powers(r: usize) -> f64 {
+    (r * (r + 1) * (2 * r + 1) * (3 * r * r + 3 * r - 1)) as f64 / 30.0
+}
+
 /// `Σ_{k=−r}^{r} (k² − m)²`, m the mean of k² over the window: the spread of a parabola's
 /// regressor (its leading coefficient has the variance σ² over it).
 fn parabola_spread(r: usize) -> f64 {
-    let fourth_powers = (r * (r + 1) * (2 * r + 1) * (3 * r * r + 3 * r - 1)) as f64 / 30.0;
     let squares = 2.0 * sum_of_squares(r);
-    2.0 * fourth_powers - squares * squares / (2 * r + 1) as f64
+    2.0 * sum_of_fourth_powers(r) - squares * squares / (2 * r + 1) as f64
 }
 
 /// Holds each frame's points until the frames their windows need have arrived, keeping the
