@@ -11,7 +11,7 @@ use std::path::Path;
 use sillage_core::{Detection, FrameIndex, ObjectClass, Point2, Result};
 
 use crate::WrittenSummary;
-use crate::text_table::{CsvTable, RowWriter};
+use crate::text_table::{CsvTable, RowWriter, push_f64};
 
 /// The header of detection CSV files.
 pub const DETECTIONS_HEADER: &str = "frame,x,y,class,score";
@@ -35,8 +35,11 @@ impl DetectionsCsvWriter {
     pub fn push(&mut self, frame: FrameIndex, detections: &[Detection]) -> Result<()> {
         self.rows.write_rows(detections, |out, d| {
             // Writing to a String cannot fail.
-            let (x, y) = (d.pos_px.x, d.pos_px.y);
-            let _ = write!(out, "{frame},{x},{y},{},{}", d.class, d.strength);
+            let _ = write!(out, "{frame},");
+            push_f64(out, d.pos_px.x);
+            out.push(',');
+            push_f64(out, d.pos_px.y);
+            let _ = write!(out, ",{},{}", d.class, d.strength);
             Ok(())
         })
     }

@@ -12,7 +12,7 @@ use super::columns::{
     point_from_values,
 };
 use super::{TrackFileHeader, TrackWriter, WrittenSummary};
-use crate::text_table::{CsvTable, RowWriter, parse_index, push_fixed, push_opt};
+use crate::text_table::{CsvTable, RowWriter, parse_index, push_f64, push_fixed, push_opt};
 
 /// The column line of TracTrac's `_track.txt` (its third header line, after `#  `).
 pub const TRACTRAC_COLUMNS_LINE: &str =
@@ -66,11 +66,10 @@ impl TextStyle {
                 }
             }
             Self::Csv(layout) => {
-                let _ = write!(
-                    out,
-                    "{},{},{},{}",
-                    point.frame, point.track_id, point.pos_px.x, point.pos_px.y
-                );
+                let _ = write!(out, "{},{},", point.frame, point.track_id);
+                push_f64(out, point.pos_px.x);
+                out.push(',');
+                push_f64(out, point.pos_px.y);
                 for value in values {
                     out.push(',');
                     push_opt(out, value);
