@@ -132,7 +132,7 @@ fn may_tie(value: f64) -> bool {
     // m odd and k = −e: the expansion is m·5^k / 10^k, whose significant digits are those of
     // m·5^k, at least ⌊log₁₀ m⌋ + ⌊k log₁₀ 5⌋ + 1 (log₁₀ 5 rounded down).
     let k = e.unsigned_abs();
-    u64::from(m.ilog10()) + k * 69_897 / 100_000 + 1 <= 18
+    u64::from(m.ilog10()) + k * 69_897 / 100_000 < 18
 }
 
 /// Appends the number `text` (ryu's form: `-`, digits with at most one `.`, then perhaps `e`
@@ -485,7 +485,8 @@ mod tests {
             1e21,
             1e22,
             123_456.789,
-            -264_310_078_315_752.625,
+            // A tie: −264310078315752.625 exactly.
+            -(264_310_078_315_752.0 + 0.625),
             2.25,
             f64::MAX,
             f64::MIN_POSITIVE,
