@@ -97,8 +97,9 @@ pub(crate) fn push_f64(out: &mut String, value: f64) {
     }
     let mut buffer = ryu::Buffer::new();
     let text = buffer.format_finite(value);
-    // Without an exponent and not integral ("3.0"), ryu's text is already the plain form.
-    if text.contains('e') || text.ends_with(".0") {
+    // Without an exponent, ryu's text is already the plain form (integral values, which it
+    // writes "3.0", took the standard library's path above).
+    if text.contains('e') {
         push_plain_decimal(out, text);
     } else {
         out.push_str(text);

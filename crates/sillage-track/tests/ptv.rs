@@ -377,27 +377,25 @@ fn kinematics_fitted_along_trajectories_carry_far_less_position_noise() {
     };
     let (eq6, fitted) = (track(3), track(PtvParams::default().velocity_window));
     assert!(eq6.len() > 7000, "{} of 7,200 points", eq6.len());
-    let mean_error = |points: &[TrackPoint]| {
-        let total: f64 = points
-            .iter()
-            .map(|p| (p.vel_px_per_frame.unwrap() - vel).norm())
-            .sum();
-        total / points.len() as f64
+    // The mean length of `vector` over the points.
+    let mean_norm = |points: &[TrackPoint], vector: &dyn Fn(&TrackPoint) -> Vec2| {
+        points.iter().map(|p| vector(p).norm()).sum::<f64>() / points.len() as f64
     };
-    let (eq6_error, fitted_error) = (mean_error(&eq6), mean_error(&fitted));
+    let velocity_error = move |p: &TrackPoint| p.vel_px_per_frame.unwrap() - vel;
+    let (eq6_error, fitted_error) = (
+        mean_norm(&eq6, &velocity_error),
+        mean_norm(&fitted, &velocity_error),
+    );
     // Over seven frames the error's deviation is 2.6× smaller, less at the tracks' ends.
     assert!(
         fitted_error < 0.5 * eq6_error,
         "Eq. 6: {eq6_error:.4} px/frame, fitted: {fitted_error:.4}"
     );
-    let acceleration_error = |points: &[TrackPoint]| {
-        let total: f64 = points
-            .iter()
-            .map(|p| p.acc_px_per_frame2.unwrap().norm())
-            .sum();
-        total / points.len() as f64
-    };
-    let (eq7_error, parabola_error) = (acceleration_error(&eq6), acceleration_error(&fitted));
+    let acceleration = |p: &TrackPoint| p.acc_px_per_frame2.unwrap();
+    let (eq7_error, parabola_error) = (
+        mean_norm(&eq6, &acceleration),
+        mean_norm(&fitted, &acceleration),
+    );
     assert!(
         parabola_error < 0.25 * eq7_error,
         "Eq. 7: {eq7_error:.4} px/frame², fitted: {parabola_error:.4}"
