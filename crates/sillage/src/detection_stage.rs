@@ -186,6 +186,15 @@ impl DetectionStage {
         }
     }
 
+    /// Takes the pre-processed copy of the last frame, leaving `spare` (a buffer to reuse) in
+    /// its place; `None` (and `spare` dropped) when nothing runs before detection, where the
+    /// detector saw the frame itself. For a run that tracks a frame while the next is
+    /// detected.
+    pub fn take_preprocessed(&mut self, spare: GrayImage) -> Option<GrayImage> {
+        self.preprocessing
+            .then(|| std::mem::replace(&mut self.preprocessed, spare))
+    }
+
     /// The detector-confidence candidates of Eq. (1) of the MMPF+ paper found in the last
     /// frame (empty for detectors that make none).
     pub fn candidates(&self) -> &[Detection] {

@@ -1,5 +1,7 @@
 //! The composition root: frames → pre-processing → detector → tracker → sink.
 
+mod overlap;
+
 use std::time::{Duration, Instant};
 
 use sillage_core::{
@@ -98,7 +100,8 @@ pub struct RunSummary {
     pub points: u64,
     /// Distinct trajectories among them.
     pub tracks: u64,
-    /// Mean wall time of pre-processing + detection per frame, ms.
+    /// Mean wall time of pre-processing + detection per frame, ms (in a whole run, on its own
+    /// thread while the previous frame is tracked: the two stages overlap).
     pub detect_ms_per_frame: f64,
     /// Mean wall time of tracking per frame, ms.
     pub track_ms_per_frame: f64,
@@ -352,13 +355,16 @@ impl Pipeline {
         on_frame: &mut FrameObserver<'_>,
     ) -> Result<RunSummary> {
         if self.training_passes == 0 {
-            return self.run_resumable(
+            let mut tally = RunTally::default();
+            let timings = overlap::run(
+                &mut self.stage,
+                &mut self.tracker,
                 inputs,
-                sink,
-                RunTally::default(),
+                &mut *sink,
+                &mut tally,
                 on_frame,
-                &mut |_, _, _| Ok(()),
-            );
+            )?;
+            return self.finish_run(sink, tally, timings);
         }
         let mut tally = RunTally::default();
         let mut timings = Timings::default();
@@ -505,8 +511,7 @@ impl Pipeline {
 
     /// Feeds `self.detections` of frame `index` to the tracker, with the image the detector saw
     /// and its candidates when `frame` is at hand (not in replayed training passes), else the
-    /// candidates given with the detections; counts the frame and its points in `tally`, then
-    /// shows the report to `on_frame`.
+    /// candidates given with the detections (see [`track_frame`]).
     fn track<S: TrackSink + ?Sized>(
         &mut self,
         index: FrameIndex,
@@ -516,8 +521,6 @@ impl Pipeline {
         tally: &mut RunTally,
         on_frame: &mut FrameObserver<'_>,
     ) -> Result<FrameReport> {
-        let before = tally.points;
-        let start = Instant::now();
         let (image, candidates) = match frame {
             Some(frame) => (
                 Some(self.stage.detector_input(frame)),
@@ -531,27 +534,14 @@ impl Pipeline {
             image,
             candidates,
         };
-        let mut counting = CountingSink {
-            inner: &mut *sink,
-            tally: &mut *tally,
-        };
-        self.tracker
-            .as_tracker()
-            .step(&observations, &mut counting)?;
-        tally.frames += 1;
-        tally.last_frame = Some(index);
-        tally.detections += self.detections.len() as u64;
-        tally.candidates += candidates.len() as u64;
-        let report = FrameReport {
-            frame: index,
-            detections: self.detections.len(),
-            candidates: candidates.len(),
-            points_emitted: (tally.points - before) as usize,
+        track_frame(
+            &mut self.tracker,
+            &observations,
             detect_time,
-            track_time: start.elapsed(),
-        };
-        on_frame(&report, &observations);
-        Ok(report)
+            sink,
+            tally,
+            on_frame,
+        )
     }
 
     /// First (forward) pass of a trained run: detects every frame, keeps the detections and
@@ -599,6 +589,39 @@ impl Pipeline {
         }
         Ok(())
     }
+}
+
+/// Shows one frame's `observations` to `tracker`, its points to `sink`; counts the frame and
+/// its points in `tally`, then shows the report to `on_frame`.
+fn track_frame<S: TrackSink + ?Sized>(
+    tracker: &mut AnyTracker,
+    observations: &FrameObservations<'_>,
+    detect_time: Duration,
+    sink: &mut S,
+    tally: &mut RunTally,
+    on_frame: &mut FrameObserver<'_>,
+) -> Result<FrameReport> {
+    let before = tally.points;
+    let start = Instant::now();
+    let mut counting = CountingSink {
+        inner: &mut *sink,
+        tally: &mut *tally,
+    };
+    tracker.as_tracker().step(observations, &mut counting)?;
+    tally.frames += 1;
+    tally.last_frame = Some(observations.frame);
+    tally.detections += observations.detections.len() as u64;
+    tally.candidates += observations.candidates.len() as u64;
+    let report = FrameReport {
+        frame: observations.frame,
+        detections: observations.detections.len(),
+        candidates: observations.candidates.len(),
+        points_emitted: (tally.points - before) as usize,
+        detect_time,
+        track_time: start.elapsed(),
+    };
+    on_frame(&report, observations);
+    Ok(report)
 }
 
 #[cfg(test)]

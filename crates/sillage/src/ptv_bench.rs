@@ -10,7 +10,7 @@ use sillage_io::Frame;
 use sillage_synth::vortex::{VortexParams, VortexSequence};
 
 use crate::config::PipelineConfig;
-use crate::pipeline::Pipeline;
+use crate::pipeline::{FrameInput, Pipeline};
 use crate::process_memory::{peak_rss_mib, rss_mib};
 
 /// Frames run before timing starts (the tracker needs two frames before it links).
@@ -66,18 +66,21 @@ fn vortex_frames(
 /// (rendering is not timed), so the peak memory is that of a streaming run. Track points are
 /// dropped, so "track" times the linking itself, not the growth of an in-memory table (which
 /// cost ~5 ms per frame at 25,000 particles when the points were collected into a `Vec`).
+/// Frames are stepped one by one ([`Pipeline::step`]), so each stage is timed alone; a whole
+/// run ([`Pipeline::run`]) overlaps them.
 pub fn bench_ptv_case(size: usize, particles: usize, frames: usize) -> Result<PtvBenchRow> {
     let mut pipeline = Pipeline::from_config(&PipelineConfig::default())?;
     let (mut detect_ms, mut track_ms, mut detections, mut points) = (0.0, 0.0, 0usize, 0usize);
-    let stream = vortex_frames(size, particles, frames + WARM_UP_FRAMES)?;
-    pipeline.run(stream, &mut DiscardSink, &mut |report| {
+    for frame in vortex_frames(size, particles, frames + WARM_UP_FRAMES)? {
+        let report = pipeline.step(&FrameInput::Image(frame?), &mut DiscardSink)?;
         if report.frame as usize >= WARM_UP_FRAMES {
             detect_ms += report.detect_time.as_secs_f64() * 1e3;
             track_ms += report.track_time.as_secs_f64() * 1e3;
             detections += report.detections;
             points += report.points_emitted;
         }
-    })?;
+    }
+    pipeline.finish(&mut DiscardSink)?;
     let n = frames.max(1) as f64;
     Ok(PtvBenchRow {
         size_px: size,

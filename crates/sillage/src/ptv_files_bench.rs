@@ -23,9 +23,11 @@ pub struct PtvFilesRow {
     pub points: u64,
     /// Decoding the frames alone (one reading thread, nothing else running), ms per frame.
     pub decode_ms: f64,
-    /// Detection (pre-processing included) in the run, ms per frame.
+    /// Detection (pre-processing included) in the run, ms per frame: wall time on its own
+    /// thread, overlapped with tracking, so the two can add up to more than the wall.
     pub detect_ms: f64,
-    /// Tracking in the run, ms per frame (handing the points to the writing thread included).
+    /// Tracking in the run, ms per frame (handing the points to the writing thread included;
+    /// overlapped with the next frame's detection).
     pub track_ms: f64,
     /// Writing the run's points alone in this format (formatting, compressing, the file),
     /// ms per frame.

@@ -221,3 +221,94 @@ fn streaming_and_detection_runs_give_the_tracks_of_a_whole_run() {
         .unwrap_err();
     assert!(error.to_string().contains("training_passes"), "{error}");
 }
+
+/// A pipeline of `config` with its background model primed on `frames`.
+fn primed(config: &PipelineConfig, frames: &[Frame]) -> Pipeline {
+    let mut pipeline = Pipeline::from_config(config).unwrap();
+    pipeline
+        .prime_background(frames.iter().cloned().map(Ok))
+        .unwrap();
+    pipeline
+}
+
+/// The points of `frames` stepped one by one through [`Pipeline::step`] (no detection ahead
+/// of tracking), the background primed on them.
+fn stepped(config: &PipelineConfig, frames: Vec<Frame>) -> Vec<TrackPoint> {
+    let mut points = Vec::new();
+    let mut pipeline = primed(config, &frames);
+    for frame in frames {
+        pipeline
+            .step(&FrameInput::Image(frame), &mut points)
+            .unwrap();
+    }
+    pipeline.finish(&mut points).unwrap();
+    points
+}
+
+#[test]
+fn a_run_detecting_ahead_gives_the_frame_by_frame_points_for_any_thread_count() {
+    // Background subtraction on: its model and the pre-processed copies travel with the
+    // frames the detection thread hands over.
+    let mut config = PipelineConfig::default();
+    config.set("preprocess.background.speed=0.05").unwrap();
+    config.set("preprocess.median=3").unwrap();
+    let expected = stepped(&config, drifting_frames(14));
+    assert!(expected.len() > 36 * 8, "{} points", expected.len());
+    for threads in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut seen = Vec::new();
+        let mut points = Vec::new();
+        pool.install(|| {
+            let frames = drifting_frames(14);
+            primed(&config, &frames).run(frames.into_iter().map(Ok), &mut points, &mut |report| {
+                seen.push(report.frame)
+            })
+        })
+        .unwrap();
+        assert_eq!(points, expected, "{threads} threads");
+        assert_eq!(seen, (0..14).collect::<Vec<u64>>(), "frames shown in order");
+    }
+}
+
+#[test]
+fn a_run_detecting_ahead_stops_at_a_bad_frame_after_tracking_the_ones_before() {
+    // An input that fails (a file that does not decode) at frame 5.
+    let mut inputs: Vec<sillage::core::Result<Frame>> =
+        drifting_frames(9).into_iter().map(Ok).collect();
+    inputs[5] = Err(sillage::core::Error::input("frame5: does not decode"));
+    let mut seen = Vec::new();
+    let err = Pipeline::from_config(&PipelineConfig::default())
+        .unwrap()
+        .run(inputs.into_iter(), &mut Vec::new(), &mut |report| {
+            seen.push(report.frame)
+        })
+        .unwrap_err();
+    assert!(err.to_string().contains("frame5"), "{err}");
+    assert_eq!(seen, [0, 1, 2, 3, 4]);
+
+    // A frame the detection refuses (another size than the mask's) at frame 3.
+    let dir = tempfile::tempdir().unwrap();
+    let mask_path = dir.path().join("mask.png");
+    let mut mask = GrayImage::new(SIZE, SIZE);
+    mask.as_mut_slice().fill(1.0);
+    sillage::io::write_png16(&mask_path, &mask).unwrap();
+    let config = PipelineConfig {
+        mask: Some(mask_path),
+        ..PipelineConfig::default()
+    };
+    let mut frames = drifting_frames(8);
+    frames[3].image = GrayImage::new(SIZE / 2, SIZE);
+    let mut seen = Vec::new();
+    let err = Pipeline::from_config(&config)
+        .unwrap()
+        .run(frames.into_iter().map(Ok), &mut Vec::new(), &mut |report| {
+            seen.push(report.frame)
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("frame 3") && err.contains("mask"), "{err}");
+    assert_eq!(seen, [0, 1, 2]);
+}
