@@ -5,7 +5,7 @@
 //! `fax` crate; rows and strips are assembled here.
 
 use std::convert::Infallible;
-use std::io::{Read, Seek, SeekFrom};
+use std::io::{Read, Seek};
 
 use fax::maps::{black, white};
 use fax::{BitReader, ByteReader};
@@ -14,6 +14,7 @@ use tiff::decoder::Decoder;
 use tiff::tags::Tag;
 
 use super::decode::DecodeResult;
+use super::strips::{Strips, read_strip};
 
 /// TIFF's `Compression` value of modified Huffman run-length coding.
 pub(crate) const MODIFIED_HUFFMAN: u16 = 2;
@@ -24,7 +25,6 @@ pub(crate) fn decode_modified_huffman<R: Read + Seek>(
     decoder: &mut Decoder<R>,
 ) -> DecodeResult<GrayImage> {
     let tiff_error = |e: tiff::TiffError| e.to_string();
-    let (width, height) = decoder.dimensions().map_err(tiff_error)?;
     let bits: u16 = decoder
         .find_tag_unsigned(Tag::BitsPerSample)
         .map_err(tiff_error)?
@@ -45,48 +45,18 @@ pub(crate) fn decode_modified_huffman<R: Read + Seek>(
         .find_tag_unsigned::<u16>(Tag::FillOrder)
         .map_err(tiff_error)?
         == Some(2);
-    let rows_per_strip: u32 = decoder
-        .find_tag_unsigned(Tag::RowsPerStrip)
-        .map_err(tiff_error)?
-        .unwrap_or(height)
-        .clamp(1, height.max(1));
-    let offsets: Vec<u64> = decoder
-        .get_tag_u64_vec(Tag::StripOffsets)
-        .map_err(tiff_error)?;
-    let counts: Vec<u64> = decoder
-        .get_tag_u64_vec(Tag::StripByteCounts)
-        .map_err(tiff_error)?;
-    let strips = height.div_ceil(rows_per_strip) as usize;
-    if offsets.len() < strips || counts.len() < strips {
-        return Err(format!(
-            "the image needs {strips} strips of {rows_per_strip} rows and the file lists {} \
-             offsets and {} byte counts; the file is damaged",
-            offsets.len(),
-            counts.len()
-        ));
-    }
-    // The header's size is not trusted for an allocation: pixels are appended as rows are
-    // decoded (so memory follows the file's length), up to the limit the `tiff` crate puts
-    // on the decoded samples of the other compressions.
-    let limit = tiff::decoder::Limits::default().decoding_buffer_size as u64;
-    if u64::from(width) * u64::from(height) > limit {
-        return Err(format!(
-            "{width} × {height} pixels is more than the {limit} a frame may have; the file is \
-             damaged, or crop the image"
-        ));
-    }
-    let (w, h) = (width as usize, height as usize);
+    let layout = Strips::of(decoder)?;
+    let (w, h) = (layout.width, layout.height);
     let mut pixels = Vec::new();
     let mut strip = Vec::new();
-    for (s, (&offset, &count)) in offsets.iter().zip(&counts).take(strips).enumerate() {
-        read_strip(decoder.inner(), offset, count, &mut strip)
+    for (s, &span) in layout.spans.iter().enumerate() {
+        read_strip(decoder.inner(), span, &mut strip)
             .map_err(|e| format!("cannot read strip {s}: {e}"))?;
         if lsb_first {
             strip.iter_mut().for_each(|b| *b = b.reverse_bits());
         }
-        let first_row = s * rows_per_strip as usize;
-        let rows = (h - first_row).min(rows_per_strip as usize);
-        decode_rows(&strip, w, rows, &mut pixels)
+        let first_row = s * layout.rows_per_strip;
+        decode_rows(&strip, w, layout.rows(s), &mut pixels)
             .map_err(|e| format!("row {}: {e}", first_row + e.row + 1))?;
     }
     let (white, black) = if white_is_zero {
@@ -101,27 +71,6 @@ pub(crate) fn decode_modified_huffman<R: Read + Seek>(
         .map(|bit| if bit == 0 { white } else { black })
         .collect();
     GrayImage::from_vec(w, h, grey).map_err(|e| e.to_string())
-}
-
-fn read_strip<R: Read + Seek>(
-    reader: &mut R,
-    offset: u64,
-    count: u64,
-    strip: &mut Vec<u8>,
-) -> std::io::Result<()> {
-    reader.seek(SeekFrom::Start(offset))?;
-    strip.clear();
-    reader.take(count).read_to_end(strip)?;
-    if (strip.len() as u64) < count {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::UnexpectedEof,
-            format!(
-                "the file ends {} bytes into a strip of {count}",
-                strip.len()
-            ),
-        ));
-    }
-    Ok(())
 }
 
 /// Why a row could not be decoded (its 0-based index within the strip, for the caller).

@@ -18,7 +18,7 @@ use sillage_core::{GrayImage, LUMA_601, Result, RgbImage};
 use tiff::ColorType;
 use tiff::decoder::{Decoder, DecodingResult};
 
-use super::ccitt;
+use super::{ccitt, lzw};
 
 /// Why a frame could not be decoded; the caller adds the file and the frame index.
 pub(crate) type DecodeResult<T> = std::result::Result<T, String>;
@@ -142,6 +142,14 @@ pub(crate) fn decode_tiff_page<R: std::io::Read + std::io::Seek>(
         .map_err(|e| e.to_string())?;
     if compression == Some(ccitt::MODIFIED_HUFFMAN) {
         let grey = ccitt::decode_modified_huffman(decoder)?;
+        let colour = if colour {
+            Some(grey_to_rgb(&grey)?)
+        } else {
+            None
+        };
+        return Ok(Decoded { grey, colour });
+    }
+    if let Some(grey) = lzw::decode_grey8_strips(decoder)? {
         let colour = if colour {
             Some(grey_to_rgb(&grey)?)
         } else {

@@ -7,7 +7,9 @@ mod ccitt;
 mod decode;
 mod encode;
 mod input;
+mod lzw;
 mod mp4;
+mod strips;
 mod tiff_stack;
 mod video;
 
