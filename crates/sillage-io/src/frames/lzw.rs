@@ -7,7 +7,8 @@
 //! literals stands for an earlier code's string plus one byte, and that string sits in the
 //! output already, so the table keeps only where each string starts in the strip's output and
 //! its length: decoding a code is one copy from earlier output. Other layouts (tiles, several
-//! samples per pixel, other depths, a predictor, white-is-zero) take the `tiff` crate's path.
+//! samples per pixel, other depths, the floating-point predictor, white-is-zero) take the
+//! `tiff` crate's path.
 
 use std::io::{Read, Seek};
 
@@ -23,10 +24,14 @@ pub(crate) const LZW: u16 = 5;
 const CLEAR: u16 = 256;
 const END: u16 = 257;
 const FIRST_CODE: usize = 258;
+/// TIFF's predictor tag values: none, horizontal differencing.
+const NO_PREDICTOR: u16 = 1;
+const HORIZONTAL: u16 = 2;
 const MAX_CODES: usize = 4096;
 
 /// Decodes the current page of `decoder` when it is an LZW-compressed 8-bit grey image in
-/// strips without a predictor; `None` for any other layout (left to the general path).
+/// strips, with or without the horizontal predictor (TIFF 6.0 §14); `None` for any other
+/// layout (left to the general path).
 pub(crate) fn decode_grey8_strips<R: Read + Seek>(
     decoder: &mut Decoder<R>,
 ) -> DecodeResult<Option<GrayImage>> {
@@ -38,12 +43,16 @@ pub(crate) fn decode_grey8_strips<R: Read + Seek>(
         && tag(decoder, Tag::BitsPerSample)? == Some(8)
         && tag(decoder, Tag::SamplesPerPixel)?.unwrap_or(1) == 1
         && tag(decoder, Tag::PhotometricInterpretation)? == Some(1)
-        && tag(decoder, Tag::Predictor)?.unwrap_or(1) == 1
+        && matches!(
+            tag(decoder, Tag::Predictor)?.unwrap_or(1),
+            NO_PREDICTOR | HORIZONTAL
+        )
         && tag(decoder, Tag::FillOrder)?.unwrap_or(1) == 1
         && tag(decoder, Tag::TileWidth)?.is_none();
     if !plain {
         return Ok(None);
     }
+    let horizontal = tag(decoder, Tag::Predictor)? == Some(HORIZONTAL);
     let layout = Strips::of(decoder)?;
     let (w, h) = (layout.width, layout.height);
     let mut pixels: Vec<u8> = Vec::with_capacity(w * h);
@@ -59,6 +68,14 @@ pub(crate) fn decode_grey8_strips<R: Read + Seek>(
                 "strip {s} decodes to {} of its {size} bytes; the file is damaged",
                 pixels.len() - start
             ));
+        }
+        if horizontal {
+            // Each row holds differences from the pixel to its left.
+            for row in pixels[start..].chunks_exact_mut(w) {
+                for x in 1..row.len() {
+                    row[x] = row[x].wrapping_add(row[x - 1]);
+                }
+            }
         }
     }
     let grey = pixels.into_iter().map(u8_unit).collect();
@@ -284,8 +301,8 @@ mod tests {
                 ((i % width) * 3 + (i / width) * 7 + (i.wrapping_mul(2_654_435_761) >> 27)) as u8
             })
             .collect();
-        for rows in [1, 8, 97] {
-            let file = lzw_tiff(&pixels, width, rows, false);
+        for (rows, predictor) in [(1, false), (8, false), (97, false), (1, true), (8, true)] {
+            let file = lzw_tiff(&pixels, width, rows, predictor);
             let reference = match Decoder::new(std::io::Cursor::new(&file))
                 .unwrap()
                 .read_image()
@@ -296,17 +313,25 @@ mod tests {
             };
             assert_eq!(reference, pixels);
             let mut decoder = Decoder::new(std::io::Cursor::new(&file)).unwrap();
+            let tag = decoder.find_tag_unsigned::<u16>(Tag::Predictor).unwrap();
+            assert_eq!(tag.unwrap_or(1) == HORIZONTAL, predictor);
             let grey = decode_grey8_strips(&mut decoder).unwrap().unwrap();
             assert_eq!(grey.dimensions(), (width as usize, height as usize));
             let expected: Vec<f32> = pixels.iter().map(|&p| u8_unit(p)).collect();
             assert_eq!(
                 grey.as_slice(),
                 expected.as_slice(),
-                "{rows} rows per strip"
+                "{rows} rows per strip, predictor {predictor}"
             );
         }
-        let file = lzw_tiff(&pixels, width, 8, true);
-        let mut decoder = Decoder::new(std::io::Cursor::new(&file)).unwrap();
+        // 16-bit samples are left to the `tiff` crate.
+        let mut file = std::io::Cursor::new(Vec::new());
+        tiff::encoder::TiffEncoder::new(&mut file)
+            .unwrap()
+            .with_compression(tiff::encoder::Compression::Lzw)
+            .write_image::<tiff::encoder::colortype::Gray16>(4, 2, &[1, 2, 3, 4, 5, 6, 7, 8])
+            .unwrap();
+        let mut decoder = Decoder::new(std::io::Cursor::new(file.into_inner())).unwrap();
         assert!(decode_grey8_strips(&mut decoder).unwrap().is_none());
         // A damaged strip (its codes overwritten past its start) is an error naming it.
         let mut file = lzw_tiff(&pixels, width, 48, false);
