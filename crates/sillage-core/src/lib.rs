@@ -30,6 +30,7 @@ mod observation;
 mod rng;
 mod roles;
 mod settings;
+mod simd;
 
 pub use bbox::BoundingBox;
 pub use calibration::Calibration;

@@ -62,6 +62,8 @@ pub mod weights;
 
 mod fast_math;
 mod filter;
+mod lanes;
+mod sums;
 
 pub use filter::{FilterSpec, ParticleFilter, StepReport, StepSummary, step_all};
 pub use fit::{

@@ -110,7 +110,12 @@ impl Gauss2 {
     /// One draw, with standard deviations multiplied by `scale` (√ of a variance factor).
     #[inline]
     pub fn sample(&self, scale: f64, normals: &mut Normals<'_>) -> (f64, f64) {
-        let (z1, z2) = normals.pair();
+        self.correlate(scale, normals.pair())
+    }
+
+    /// The draw made of the standard normal pair `(z1, z2)`: `scale·L·z`.
+    #[inline(always)]
+    pub(crate) fn correlate(&self, scale: f64, (z1, z2): (f64, f64)) -> (f64, f64) {
         (
             scale * self.l11 * z1,
             scale * (self.l21 * z1 + self.l22 * z2),

@@ -2,6 +2,7 @@
 //! "normalizing", §3.5.2), effective sample size and the recovery of an all-zero weight set.
 
 use crate::fast_math::exp_nonpositive;
+use crate::sums::lane_max;
 
 /// What one normalisation found.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,30 +36,11 @@ pub fn sanitise_log_likelihood(value: f64) -> f64 {
     }
 }
 
-/// Normalises `log_weights` in place so that `Σᵢ exp(log_weightsᵢ) = 1`, and writes the linear
-/// normalised weights to `linear` (same length). When every weight is zero the set is reset to
-/// uniform and `recovered` says so: the caller counts that event.
-pub fn normalise(log_weights: &mut [f64], linear: &mut [f64]) -> Normalisation {
-    debug_assert_eq!(log_weights.len(), linear.len());
-    let n = log_weights.len();
-    let max = log_weights
-        .iter()
-        .copied()
-        .fold(f64::NEG_INFINITY, f64::max);
-    // f64::max skips NaN, so an all-NaN set also ends at −∞ here.
-    if n == 0 || max == f64::NEG_INFINITY {
-        let uniform = -(n.max(1) as f64).ln();
-        log_weights.fill(uniform);
-        linear.fill(1.0 / n.max(1) as f64);
-        return Normalisation {
-            log_evidence: f64::NEG_INFINITY,
-            ess: n as f64,
-            recovered: true,
-        };
-    }
-    // e = exp(x − max) ∈ [0, 1]: no overflow, and the largest term is exactly 1, so the sum
-    // cannot underflow either. The exponentials in one vectorisable pass, then Σ e and Σ e²
-    // over four fixed lanes (the same order, so the same bits, on every machine).
+/// `linear[i] = exp(log_weights[i] − max)`, and `(Σ linear, Σ linear²)`: the exponentials in
+/// one vectorisable pass, then the sums over four fixed lanes (the same order, so the same
+/// bits, on every machine).
+#[inline(always)]
+fn exponentials(log_weights: &[f64], linear: &mut [f64], max: f64) -> (f64, f64) {
     for (lw, w) in log_weights.iter().zip(linear.iter_mut()) {
         *w = exp_nonpositive(lw - max);
     }
@@ -74,8 +56,38 @@ pub fn normalise(log_weights: &mut [f64], linear: &mut [f64]) -> Normalisation {
         sums[lane] += e;
         squares[lane] += e * e;
     }
-    let sum = (sums[0] + sums[1]) + (sums[2] + sums[3]);
-    let sum_sq = (squares[0] + squares[1]) + (squares[2] + squares[3]);
+    (
+        (sums[0] + sums[1]) + (sums[2] + sums[3]),
+        (squares[0] + squares[1]) + (squares[2] + squares[3]),
+    )
+}
+
+sillage_core::multiversion! {
+    /// [`exponentials`] on the widest SIMD the CPU offers.
+    fn exponentials_widest(log_weights: &[f64], linear: &mut [f64], max: f64) -> (f64, f64) => exponentials
+}
+
+/// Normalises `log_weights` in place so that `Σᵢ exp(log_weightsᵢ) = 1`, and writes the linear
+/// normalised weights to `linear` (same length). When every weight is zero the set is reset to
+/// uniform and `recovered` says so: the caller counts that event.
+pub fn normalise(log_weights: &mut [f64], linear: &mut [f64]) -> Normalisation {
+    debug_assert_eq!(log_weights.len(), linear.len());
+    let n = log_weights.len();
+    let max = lane_max(log_weights);
+    // The maximum skips NaN, so an all-NaN set also ends at −∞ here.
+    if n == 0 || max == f64::NEG_INFINITY {
+        let uniform = -(n.max(1) as f64).ln();
+        log_weights.fill(uniform);
+        linear.fill(1.0 / n.max(1) as f64);
+        return Normalisation {
+            log_evidence: f64::NEG_INFINITY,
+            ess: n as f64,
+            recovered: true,
+        };
+    }
+    // e = exp(x − max) ∈ [0, 1]: no overflow, and the largest term is exactly 1, so the sum
+    // cannot underflow either.
+    let (sum, sum_sq) = exponentials_widest(log_weights, linear, max);
     let log_norm = max + sum.ln();
     let inv = 1.0 / sum;
     for (lw, w) in log_weights.iter_mut().zip(linear.iter_mut()) {

@@ -1,5 +1,5 @@
-//! The ziggurat normals against the normal distribution: a χ² test over 34 bins (probabilities
-//! from Simpson integration of the density), the moments, and the far tail.
+//! The block Box–Muller normals against the normal distribution: a χ² test over 34 bins
+//! (probabilities from Simpson integration of the density), the moments, and the far tail.
 
 use sillage_core::rng_stream;
 use sillage_filter::Normals;
@@ -60,7 +60,8 @@ fn histogram_matches_the_normal_density() {
 }
 
 /// Mean, variance and kurtosis to 5 standard errors (√(1/n), √(2/n), √(96/n)), and the tail
-/// beyond |z| > 3.5 (p = 4.65e-4, the part only the slow path produces) to 5 binomial errors.
+/// beyond |z| > 3.5 (p = 4.65e-4, the part a truncated or too coarse radius would miss) to 5
+/// binomial errors.
 #[test]
 fn moments_and_tail() {
     let z = draws(2);

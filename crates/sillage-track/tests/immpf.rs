@@ -181,7 +181,10 @@ impl Scene {
 }
 
 /// For each estimate, the walker it covers (IoU ≥ 0.5), and the largest foot error, px.
-fn check(estimates: &[PedestrianEstimate], turn_at: usize) -> (Vec<(u64, usize)>, f64) {
+fn try_check(
+    estimates: &[PedestrianEstimate],
+    turn_at: usize,
+) -> Result<(Vec<(u64, usize)>, f64), String> {
     let mut pairs = Vec::new();
     let mut worst: f64 = 0.0;
     for e in estimates {
@@ -190,19 +193,47 @@ fn check(estimates: &[PedestrianEstimate], turn_at: usize) -> (Vec<(u64, usize)>
             .map(|k| (k, e.bbox.iou(&truth(frame, k, turn_at))))
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap();
-        assert!(
-            iou >= 0.5,
-            "frame {frame}: track {} covers no walker (IoU {iou:.2})",
-            e.track_id
-        );
+        if iou < 0.5 {
+            return Err(format!(
+                "frame {frame}: track {} covers no walker (IoU {iou:.2})",
+                e.track_id
+            ));
+        }
         pairs.push((e.track_id, k));
         worst = worst.max((e.bbox.foot() - truth(frame, k, turn_at).foot()).norm());
     }
     pairs.sort_unstable();
     pairs.dedup();
-    (pairs, worst)
+    Ok((pairs, worst))
 }
 
+/// As [`try_check`], panicking on a box that covers no walker.
+fn check(estimates: &[PedestrianEstimate], turn_at: usize) -> (Vec<(u64, usize)>, f64) {
+    try_check(estimates, turn_at).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Seeds each rate test runs.
+const RATE_SEEDS: u64 = 40;
+
+/// Runs `outcome` for seeds 1 to [`RATE_SEEDS`] and asserts that at least `needed` succeed:
+/// scenes whose success depends on the random draws (a particle cloud left without
+/// measurements) are checked as a rate, not on one seed that happens to pass. Each `needed`
+/// is the 1 % point of the binomial at the success rate measured over seeds 1-200 (below
+/// it a correct engine fails once in a hundred runs of new streams).
+fn assert_success_rate(needed: u64, outcome: impl Fn(u64) -> Result<(), String>) {
+    let failures: Vec<String> = (1..=RATE_SEEDS)
+        .filter_map(|seed| outcome(seed).err().map(|e| format!("seed {seed}: {e}")))
+        .collect();
+    let successes = RATE_SEEDS - failures.len() as u64;
+    assert!(
+        successes >= needed,
+        "{successes} of {RATE_SEEDS} seeds succeed, {needed} needed: {failures:#?}"
+    );
+}
+
+/// Two walkers born on frame 1 and followed for 39 frames on colour and motion alone. Over
+/// seeds 1-200 the engine of 2026-11-29 (ziggurat normals) succeeded on 129, the block
+/// Box–Muller engine that replaced it on 140 (rate ≈ 0.67): 20 of 40 needed (≈ 27 expected).
 #[test]
 fn colour_and_motion_follow_two_walkers_with_one_identity_each() {
     let mut params = PedestrianParams {
@@ -215,20 +246,35 @@ fn colour_and_motion_follow_two_walkers_with_one_identity_each() {
     };
     // Every walker is born on frame 1 and never supported by a blob again.
     params.unsupported_frames = 1000;
-    let estimates = run(&params, Scene::straight(40, true), 3);
-    let (pairs, worst) = check(&estimates, usize::MAX);
-    assert_eq!(pairs, [(1, 0), (2, 1)], "one track per walker, no other");
-    assert!(worst < 6.0, "largest foot error {worst:.2} px");
-    let last = estimates.iter().filter(|e| e.frame == 39).count();
-    assert_eq!(last, 2, "both walkers still followed at the last frame");
-    // Walkers in straight lines: constant velocity carries most of the weight.
-    let cv_share: f64 = estimates
-        .iter()
-        .filter(|e| e.frame == 39)
-        .map(|e| e.model_weights[0])
-        .sum::<f64>()
-        / 2.0;
-    assert!(cv_share > 0.3, "CV weight {cv_share:.2}");
+    assert_success_rate(20, |seed| {
+        let estimates = run(&params, Scene::straight(40, true), seed);
+        let (pairs, worst) = try_check(&estimates, usize::MAX)?;
+        if pairs != [(1, 0), (2, 1)] {
+            return Err(format!(
+                "tracks and walkers {pairs:?}: one track per walker expected"
+            ));
+        }
+        if worst >= 6.0 {
+            return Err(format!("largest foot error {worst:.2} px"));
+        }
+        let last = estimates.iter().filter(|e| e.frame == 39).count();
+        if last != 2 {
+            return Err(format!(
+                "{last} walkers followed at the last frame, 2 expected"
+            ));
+        }
+        // Walkers in straight lines: constant velocity carries most of the weight.
+        let cv_share: f64 = estimates
+            .iter()
+            .filter(|e| e.frame == 39)
+            .map(|e| e.model_weights[0])
+            .sum::<f64>()
+            / 2.0;
+        if cv_share <= 0.3 {
+            return Err(format!("CV weight {cv_share:.2}"));
+        }
+        Ok(())
+    });
 }
 
 #[test]
@@ -616,7 +662,7 @@ fn a_walker_missed_for_ten_frames_keeps_its_identity() {
 
 /// A walker coming towards the camera, its box 3.5 px taller every frame, missed for 21 frames
 /// (20-40): its tracker's box keeps growing at the detections' rate while it coasts and takes
-/// the walker back (one identity, every seed); with the size frozen (`size_rate` false) the
+/// the walker back (one identity on ≈ 87 % of seeds); with the size frozen (`size_rate` false) the
 /// coasting box is a quarter of the returning detection's area, under the IoU gate, and the
 /// walker comes back under a new identity.
 #[test]
@@ -634,18 +680,21 @@ fn a_walker_coming_closer_while_missed_is_taken_back_at_its_new_size() {
     assert!(params.detection.size_rate && params.detection.lost_frames > 21);
     let mut frozen = params.clone();
     frozen.detection.size_rate = false;
-    for seed in 1..=3 {
+    // Over seeds 1-200 the walker came back as one identity for 177 (ziggurat engine of
+    // 2026-11-29) and 174 (block Box–Muller engine) seeds (rate ≈ 0.87): 30 of 40 needed
+    // (≈ 35 expected).
+    assert_success_rate(30, |seed| {
         let out = on_candidates(&params, 50, scene, seed);
-        assert_eq!(
-            identities(&out).len(),
-            1,
-            "seed {seed}: {:?}",
-            identities(&out)
-        );
-        assert!(
-            out.iter().any(|e| e.frame == 49),
-            "seed {seed}: reported again"
-        );
+        if identities(&out).len() != 1 {
+            return Err(format!("identities {:?}", identities(&out)));
+        }
+        if !out.iter().any(|e| e.frame == 49) {
+            return Err("not reported again".into());
+        }
+        Ok(())
+    });
+    // Without the size rate the walker's new size is never matched: a second identity.
+    for seed in 1..=3 {
         let out = on_candidates(&frozen, 50, scene, seed);
         assert_eq!(identities(&out).len(), 2, "seed {seed}, frozen size");
     }

@@ -7,7 +7,7 @@ use sillage_core::{Error, Result, RngStream};
 
 use crate::motion::MotionModel;
 use crate::noise::{Gauss2, Noise2};
-use crate::normal::Normals;
+use crate::normal::{BLOCK, Block, Normals};
 use crate::params::{KinematicParams, SwitchingParams};
 use crate::particles::{Columns, Particles};
 use crate::switching::TransitionTable;
@@ -103,43 +103,221 @@ impl KinematicModel {
         matches!(self, Self::ConstantAcceleration { .. })
     }
 
+    /// Standard normal pairs one step of this model draws: position, velocity, acceleration.
+    fn draws(&self) -> usize {
+        match self {
+            Self::ConstantPosition { .. } => 1,
+            Self::ConstantVelocity { .. } => 2,
+            Self::ConstantAcceleration { .. } => 3,
+        }
+    }
+
+    /// The state after one frame (Eqs. (10)-(12)), given standard normal pairs `z` for the
+    /// position, velocity and acceleration noises.
+    #[inline(always)]
+    fn moved(&self, s: Kinematics, z: &Draws) -> Kinematics {
+        match self {
+            Self::ConstantPosition { pos } => position_step(pos, s, z),
+            Self::ConstantVelocity { pos, vel } => velocity_step(pos, vel, s, z),
+            Self::ConstantAcceleration { pos, vel, acc } => acceleration_step(pos, vel, acc, s, z),
+        }
+    }
+
     /// Moves particle `i` one frame.
     #[inline]
     pub(crate) fn advance(&self, c: &mut Columns<'_>, i: usize, normals: &mut Normals<'_>) {
-        match self {
-            Self::ConstantPosition { pos } => {
-                constant_position(c, i, pos, 1.0, normals);
-                c.vel_x[i] = 0.0;
-                c.vel_y[i] = 0.0;
-                zero_acceleration(c, i);
-            }
-            Self::ConstantVelocity { pos, vel } => {
-                constant_velocity(c, i, pos, vel, 1.0, normals);
-                zero_acceleration(c, i);
-            }
-            Self::ConstantAcceleration { pos, vel, acc } => {
-                let (dx, dy) = pos.sample(1.0, normals);
-                let (du, dv) = vel.sample(1.0, normals);
-                let (dax, day) = acc.sample(1.0, normals);
-                let (ax, ay) = (c.acc_x[i], c.acc_y[i]);
-                c.pos_x[i] += c.vel_x[i] + 0.5 * ax + dx;
-                c.pos_y[i] += c.vel_y[i] + 0.5 * ay + dy;
-                c.vel_x[i] += ax + du;
-                c.vel_y[i] += ay + dv;
-                c.acc_x[i] += dax;
-                c.acc_y[i] += day;
-            }
+        let mut z = [(0.0, 0.0); 3];
+        for pair in &mut z[..self.draws()] {
+            *pair = normals.pair();
+        }
+        let acc = |column: &[f64]| column.get(i).copied().unwrap_or(0.0);
+        let state = Kinematics {
+            x: c.pos_x[i],
+            y: c.pos_y[i],
+            u: c.vel_x[i],
+            v: c.vel_y[i],
+            ax: acc(c.acc_x),
+            ay: acc(c.acc_y),
+        };
+        let moved = self.moved(state, &z);
+        c.pos_x[i] = moved.x;
+        c.pos_y[i] = moved.y;
+        c.vel_x[i] = moved.u;
+        c.vel_y[i] = moved.v;
+        if let (Some(ax), Some(ay)) = (c.acc_x.get_mut(i), c.acc_y.get_mut(i)) {
+            *ax = moved.ax;
+            *ay = moved.ay;
         }
     }
 }
 
-/// Sets particle `i`'s acceleration to zero where the set has acceleration columns (the zero
-/// blocks of `A₁` and `A₂`, Eqs. (10)-(11) of the IMM-PF paper).
-#[inline]
-fn zero_acceleration(c: &mut Columns<'_>, i: usize) {
-    if let (Some(ax), Some(ay)) = (c.acc_x.get_mut(i), c.acc_y.get_mut(i)) {
-        *ax = 0.0;
-        *ay = 0.0;
+/// One particle's state as the kinematic models move it (acceleration 0 where the set has no
+/// acceleration columns).
+#[derive(Debug, Clone, Copy, Default)]
+struct Kinematics {
+    x: f64,
+    y: f64,
+    u: f64,
+    v: f64,
+    ax: f64,
+    ay: f64,
+}
+
+/// Standard normal pairs for the position, velocity and acceleration noises of one particle.
+type Draws = [(f64, f64); 3];
+
+/// Eq. (10), constant position: `x ← x + ε_x`, velocity and acceleration set to zero.
+#[inline(always)]
+fn position_step(pos: &Gauss2, s: Kinematics, z: &Draws) -> Kinematics {
+    let (dx, dy) = pos.correlate(1.0, z[0]);
+    Kinematics {
+        x: s.x + dx,
+        y: s.y + dy,
+        ..Kinematics::default()
+    }
+}
+
+/// Eq. (11), constant velocity: `x ← x + u + ε_x`, `u ← u + ε_u`, acceleration set to zero.
+#[inline(always)]
+fn velocity_step(pos: &Gauss2, vel: &Gauss2, s: Kinematics, z: &Draws) -> Kinematics {
+    let (dx, dy) = pos.correlate(1.0, z[0]);
+    let (du, dv) = vel.correlate(1.0, z[1]);
+    Kinematics {
+        x: s.x + (s.u + dx),
+        y: s.y + (s.v + dy),
+        u: s.u + du,
+        v: s.v + dv,
+        ..Kinematics::default()
+    }
+}
+
+/// Eq. (12), constant acceleration: `x ← x + u + a/2 + ε_x`, `u ← u + a + ε_u`,
+/// `a ← a + ε_a`.
+#[inline(always)]
+fn acceleration_step(
+    pos: &Gauss2,
+    vel: &Gauss2,
+    acc: &Gauss2,
+    s: Kinematics,
+    z: &Draws,
+) -> Kinematics {
+    let (dx, dy) = pos.correlate(1.0, z[0]);
+    let (du, dv) = vel.correlate(1.0, z[1]);
+    let (dax, day) = acc.correlate(1.0, z[2]);
+    Kinematics {
+        x: s.x + ((s.u + 0.5 * s.ax) + dx),
+        y: s.y + ((s.v + 0.5 * s.ay) + dy),
+        u: s.u + (s.ax + du),
+        v: s.v + (s.ay + dv),
+        ax: s.ax + dax,
+        ay: s.ay + day,
+    }
+}
+
+/// Moves every particle one frame by `models[mode]` (the only model when there is one), a
+/// chunk of [`BLOCK`] particles at a time: the noise pairs of a chunk are drawn as blocks, then
+/// each model updates the chunk's columns in a loop the compiler vectorises, keeping the
+/// particles of other modes as they were. The same [`KinematicModel::moved`] equations as
+/// [`KinematicModel::advance`], one chunk instead of one particle at a time.
+fn advance_in_chunks(models: &[KinematicModel], c: &mut Columns<'_>, normals: &mut Normals<'_>) {
+    let draws = models.iter().map(KinematicModel::draws).max().unwrap_or(0);
+    let mut blocks = [Block::ZERO, Block::ZERO, Block::ZERO];
+    let (mut spare_x, mut spare_y) = ([0.0; BLOCK], [0.0; BLOCK]);
+    let n = c.mode.len();
+    for start in (0..n).step_by(BLOCK) {
+        let range = start..(start + BLOCK).min(n);
+        let len = range.len();
+        for block in &mut blocks[..draws] {
+            normals.fill_block(block);
+        }
+        let (acc_x, acc_y) = if c.acc_x.is_empty() {
+            (&mut spare_x[..len], &mut spare_y[..len])
+        } else {
+            (&mut c.acc_x[range.clone()], &mut c.acc_y[range.clone()])
+        };
+        let mut chunk = Chunk {
+            x: &mut c.pos_x[range.clone()],
+            y: &mut c.pos_y[range.clone()],
+            u: &mut c.vel_x[range.clone()],
+            v: &mut c.vel_y[range.clone()],
+            ax: acc_x,
+            ay: acc_y,
+            mode: &c.mode[range],
+        };
+        for (mode, model) in models.iter().enumerate() {
+            let only = (models.len() > 1).then_some(mode as u8);
+            advance_chunk_widest(&mut chunk, model, only, &blocks);
+        }
+    }
+}
+
+sillage_core::multiversion! {
+    /// [`Chunk::advance`] on the widest SIMD the CPU offers.
+    fn advance_chunk_widest(chunk: &mut Chunk<'_>, model: &KinematicModel, only: Option<u8>, blocks: &[Block; 3]) => Chunk::advance
+}
+
+/// The columns of one chunk of particles.
+struct Chunk<'a> {
+    x: &'a mut [f64],
+    y: &'a mut [f64],
+    u: &'a mut [f64],
+    v: &'a mut [f64],
+    ax: &'a mut [f64],
+    ay: &'a mut [f64],
+    mode: &'a [u8],
+}
+
+impl Chunk<'_> {
+    /// Moves the chunk's particles by `model`, only those in mode `only` when given.
+    #[inline(always)]
+    fn advance(&mut self, model: &KinematicModel, only: Option<u8>, blocks: &[Block; 3]) {
+        // One loop per model, so that the compiler sees straight-line arithmetic.
+        match *model {
+            KinematicModel::ConstantPosition { pos } => {
+                self.apply(only, blocks, |s, z| position_step(&pos, s, z));
+            }
+            KinematicModel::ConstantVelocity { pos, vel } => {
+                self.apply(only, blocks, |s, z| velocity_step(&pos, &vel, s, z));
+            }
+            KinematicModel::ConstantAcceleration { pos, vel, acc } => {
+                self.apply(only, blocks, |s, z| {
+                    acceleration_step(&pos, &vel, &acc, s, z)
+                });
+            }
+        }
+    }
+
+    /// `step` applied to the particles in mode `only` (all when `None`), branch-free.
+    #[inline(always)]
+    fn apply(
+        &mut self,
+        only: Option<u8>,
+        blocks: &[Block; 3],
+        step: impl Fn(Kinematics, &Draws) -> Kinematics,
+    ) {
+        let every = only.is_none();
+        let wanted = only.unwrap_or(0);
+        let len = self.x.len();
+        for j in 0..len {
+            let state = Kinematics {
+                x: self.x[j],
+                y: self.y[j],
+                u: self.u[j],
+                v: self.v[j],
+                ax: self.ax[j],
+                ay: self.ay[j],
+            };
+            let z = blocks.each_ref().map(|b| (b.first[j], b.second[j]));
+            let moved = step(state, &z);
+            let take = every | (self.mode[j] == wanted);
+            let pick = |new: f64, old: f64| if take { new } else { old };
+            self.x[j] = pick(moved.x, state.x);
+            self.y[j] = pick(moved.y, state.y);
+            self.u[j] = pick(moved.u, state.u);
+            self.v[j] = pick(moved.v, state.v);
+            self.ax[j] = pick(moved.ax, state.ax);
+            self.ay[j] = pick(moved.ay, state.ay);
+        }
     }
 }
 
@@ -149,10 +327,7 @@ impl MotionModel for KinematicModel {
             particles.enable_acceleration();
         }
         let mut c = particles.columns_mut();
-        let mut normals = Normals::new(rng);
-        for i in 0..c.mode.len() {
-            self.advance(&mut c, i, &mut normals);
-        }
+        advance_in_chunks(std::slice::from_ref(self), &mut c, &mut Normals::new(rng));
     }
 }
 
@@ -207,12 +382,9 @@ impl MotionModel for Switching {
         }
         let mut c = particles.columns_mut();
         let mut normals = Normals::new(rng);
-        for i in 0..c.mode.len() {
-            let next = self
-                .table
-                .next_state(usize::from(c.mode[i]), normals.uniform());
-            c.mode[i] = next as u8;
-            self.models[next].advance(&mut c, i, &mut normals);
+        for mode in c.mode.iter_mut() {
+            *mode = self.table.next_state(usize::from(*mode), normals.uniform()) as u8;
         }
+        advance_in_chunks(&self.models, &mut c, &mut normals);
     }
 }

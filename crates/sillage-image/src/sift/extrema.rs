@@ -14,7 +14,7 @@
 use std::ops::Range;
 
 use super::pyramid::{BORDER, Octave};
-use super::simd::multiversion;
+use sillage_core::multiversion;
 
 /// Columns tested at once by [`RowCandidates`].
 const STRIP: usize = 64;

@@ -47,7 +47,6 @@ mod extrema;
 mod orientation;
 pub mod params;
 mod pyramid;
-mod simd;
 
 use rayon::prelude::*;
 use sillage_core::{GrayImage, Result};

@@ -18,8 +18,8 @@ use rayon::prelude::*;
 use sillage_core::{Error, GrayImage, Result};
 
 use super::params::SiftParams;
-use super::simd::multiversion;
 use crate::gaussian::GaussianFilter;
+use sillage_core::multiversion;
 
 /// Pixels left out at each side of an octave when searching extrema (OpenCV's `SIFT_IMG_BORDER`).
 pub(crate) const BORDER: usize = 5;
