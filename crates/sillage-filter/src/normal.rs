@@ -10,8 +10,8 @@
 //! rejection), which the compiler vectorises: AVX-512 or AVX2 where the CPU has them, with the
 //! same bits on every path. The logarithm, cosine and sine are single precision (errors below
 //! 3·10⁻⁷, far below any noise they scale), which doubles the lanes per vector; the draws are
-//! returned as `f64`. Measured against the one-at-a-time ziggurat this replaced, in
-//! BENCHMARKS.md ("Particle-filter engine", run 6).
+//! widened to `f64` where they are used. Measured against the one-at-a-time ziggurat this
+//! replaced in BENCHMARKS.md ("Particle-filter engine", run 6).
 
 use rand::RngExt;
 use sillage_core::RngStream;
@@ -24,13 +24,14 @@ pub(crate) const BLOCK: usize = 32;
 /// 2⁻³²: one step of a 32-bit word as a uniform.
 const WORD_STEP: f32 = 1.0 / 4_294_967_296.0;
 
-/// One block of pairs: the first and the second normal of each pair.
+/// One block of pairs: the first and the second normal of each pair, in single precision
+/// (so that the loop that draws them is single precision throughout: twice the lanes).
 #[derive(Clone)]
 pub(crate) struct Block {
     /// First draw of each pair.
-    pub(crate) first: [f64; BLOCK],
+    pub(crate) first: [f32; BLOCK],
     /// Second draw of each pair.
-    pub(crate) second: [f64; BLOCK],
+    pub(crate) second: [f32; BLOCK],
 }
 
 impl Block {
@@ -39,6 +40,12 @@ impl Block {
         first: [0.0; BLOCK],
         second: [0.0; BLOCK],
     };
+
+    /// Pair `j` as `f64`.
+    #[inline(always)]
+    pub(crate) fn pair(&self, j: usize) -> (f64, f64) {
+        (f64::from(self.first[j]), f64::from(self.second[j]))
+    }
 }
 
 /// Fills `block` from `generators`: two words per pair, element-wise.
@@ -55,8 +62,8 @@ fn box_muller(generators: &mut LaneGenerators, block: &mut Block) {
             let u = (radial[l] as f32 + 1.0) * WORD_STEP;
             let radius = (-2.0 * ln_unit_f32(u)).sqrt();
             let (cos, sin) = cos_sin_turn_f32(angular[l]);
-            first[l] = f64::from(radius * cos);
-            second[l] = f64::from(radius * sin);
+            first[l] = radius * cos;
+            second[l] = radius * sin;
         }
     }
 }
@@ -91,7 +98,7 @@ impl<'r> Normals<'r> {
         if self.next >= BLOCK {
             self.refill();
         }
-        let pair = (self.block.first[self.next], self.block.second[self.next]);
+        let pair = self.block.pair(self.next);
         self.next += 1;
         pair
     }

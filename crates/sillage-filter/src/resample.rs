@@ -179,8 +179,10 @@ fn exponentials(generators: &mut LaneGenerators, out: &mut [f64]) {
     const WORD_STEP: f32 = 1.0 / 4_294_967_296.0;
     for chunk in out.chunks_mut(LANES) {
         let words = generators.next();
-        for (value, &word) in chunk.iter_mut().zip(&words) {
-            *value = f64::from(-ln_unit_f32((word as f32 + 1.0) * WORD_STEP));
+        // Single precision throughout first (twice the lanes), then widened.
+        let draws = words.map(|word| -ln_unit_f32((word as f32 + 1.0) * WORD_STEP));
+        for (value, &draw) in chunk.iter_mut().zip(&draws) {
+            *value = f64::from(draw);
         }
     }
 }

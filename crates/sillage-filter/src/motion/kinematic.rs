@@ -222,26 +222,25 @@ fn acceleration_step(
 fn advance_in_chunks(models: &[KinematicModel], c: &mut Columns<'_>, normals: &mut Normals<'_>) {
     let draws = models.iter().map(KinematicModel::draws).max().unwrap_or(0);
     let mut blocks = [Block::ZERO, Block::ZERO, Block::ZERO];
-    let (mut spare_x, mut spare_y) = ([0.0; BLOCK], [0.0; BLOCK]);
     let n = c.mode.len();
     for start in (0..n).step_by(BLOCK) {
         let range = start..(start + BLOCK).min(n);
-        let len = range.len();
         for block in &mut blocks[..draws] {
             normals.fill_block(block);
         }
-        let (acc_x, acc_y) = if c.acc_x.is_empty() {
-            (&mut spare_x[..len], &mut spare_y[..len])
+        // Empty when the set has no acceleration columns.
+        let acc = if c.acc_x.is_empty() {
+            0..0
         } else {
-            (&mut c.acc_x[range.clone()], &mut c.acc_y[range.clone()])
+            range.clone()
         };
         let mut chunk = Chunk {
             x: &mut c.pos_x[range.clone()],
             y: &mut c.pos_y[range.clone()],
             u: &mut c.vel_x[range.clone()],
             v: &mut c.vel_y[range.clone()],
-            ax: acc_x,
-            ay: acc_y,
+            ax: &mut c.acc_x[acc.clone()],
+            ay: &mut c.acc_y[acc],
             mode: &c.mode[range],
         };
         for (mode, model) in models.iter().enumerate() {
@@ -256,7 +255,7 @@ sillage_core::multiversion! {
     fn advance_chunk_widest(chunk: &mut Chunk<'_>, model: &KinematicModel, only: Option<u8>, blocks: &[Block; 3]) => Chunk::advance
 }
 
-/// The columns of one chunk of particles.
+/// The columns of one chunk of particles (the acceleration ones empty when the set has none).
 struct Chunk<'a> {
     x: &'a mut [f64],
     y: &'a mut [f64],
@@ -295,6 +294,21 @@ impl Chunk<'_> {
         blocks: &[Block; 3],
         step: impl Fn(Kinematics, &Draws) -> Kinematics,
     ) {
+        if self.ax.is_empty() {
+            self.apply_with::<false>(only, blocks, step);
+        } else {
+            self.apply_with::<true>(only, blocks, step);
+        }
+    }
+
+    /// [`Chunk::apply`] with (`ACC`) or without acceleration columns.
+    #[inline(always)]
+    fn apply_with<const ACC: bool>(
+        &mut self,
+        only: Option<u8>,
+        blocks: &[Block; 3],
+        step: impl Fn(Kinematics, &Draws) -> Kinematics,
+    ) {
         let every = only.is_none();
         let wanted = only.unwrap_or(0);
         let len = self.x.len();
@@ -304,10 +318,10 @@ impl Chunk<'_> {
                 y: self.y[j],
                 u: self.u[j],
                 v: self.v[j],
-                ax: self.ax[j],
-                ay: self.ay[j],
+                ax: if ACC { self.ax[j] } else { 0.0 },
+                ay: if ACC { self.ay[j] } else { 0.0 },
             };
-            let z = blocks.each_ref().map(|b| (b.first[j], b.second[j]));
+            let z = blocks.each_ref().map(|b| b.pair(j));
             let moved = step(state, &z);
             let take = every | (self.mode[j] == wanted);
             let pick = |new: f64, old: f64| if take { new } else { old };
@@ -315,8 +329,10 @@ impl Chunk<'_> {
             self.y[j] = pick(moved.y, state.y);
             self.u[j] = pick(moved.u, state.u);
             self.v[j] = pick(moved.v, state.v);
-            self.ax[j] = pick(moved.ax, state.ax);
-            self.ay[j] = pick(moved.ay, state.ay);
+            if ACC {
+                self.ax[j] = pick(moved.ax, state.ax);
+                self.ay[j] = pick(moved.ay, state.ay);
+            }
         }
     }
 }
