@@ -637,6 +637,7 @@ fn a_walker_missed_for_ten_frames_keeps_its_identity() {
     };
     let mut params = PedestrianParams::default();
     params.detection.lost_frames = 30;
+    params.detection.fill_gaps = 0;
     let out = on_detections(&params, 60, scene);
     assert_eq!(identities(&out).len(), 1, "{:?}", identities(&out));
     // Unreported while missed; re-confirmed after `min_hits` new matches, frames 30 on then
@@ -658,6 +659,50 @@ fn a_walker_missed_for_ten_frames_keeps_its_identity() {
         ..params
     };
     assert_eq!(identities(&on_detections(&short, 60, scene)).len(), 2);
+}
+
+/// With `fill_gaps` at least as long as the 10 missed frames, the walker of
+/// [`a_walker_missed_for_ten_frames_keeps_its_identity`] is reported on every frame, once, the
+/// missed ones on the line between its boxes before and after the gap; a shorter `fill_gaps`
+/// leaves the gap empty.
+#[test]
+fn a_gap_no_longer_than_fill_gaps_is_reported_interpolated() {
+    let walker_x = |f: u64| 40.0 + 2.0 * f as f64;
+    let scene = |f: u64| {
+        if (20..30).contains(&f) {
+            Vec::new()
+        } else {
+            vec![(walker_x(f), 120.0, 0.9)]
+        }
+    };
+    let mut params = PedestrianParams::default();
+    params.detection.lost_frames = 30;
+    params.detection.fill_gaps = 10;
+    let out = on_detections(&params, 60, scene);
+    assert_eq!(identities(&out).len(), 1, "{:?}", identities(&out));
+    let mut frames: Vec<u64> = out.iter().map(|e| e.frame).collect();
+    frames.sort_unstable();
+    assert_eq!(frames, (0..60).collect::<Vec<u64>>());
+    let at = |f: u64| out.iter().find(|e| e.frame == f).unwrap();
+    for f in 20..30 {
+        let (before, after, filled) = (at(19), at(30), at(f));
+        let s = (f - 19) as f64 / 11.0;
+        let expected_left = before.bbox.left_px + s * (after.bbox.left_px - before.bbox.left_px);
+        assert!(
+            (filled.bbox.left_px - expected_left).abs() < 1e-9,
+            "frame {f}"
+        );
+        let foot = filled.bbox.foot();
+        assert!(
+            (foot.x - walker_x(f)).abs() < 3.0,
+            "frame {f}: foot {foot:?}"
+        );
+        assert!((foot.y - 120.0).abs() < 3.0, "frame {f}: foot {foot:?}");
+        assert!((filled.vel_px_per_frame.x - 2.0).abs() < 0.5, "frame {f}");
+    }
+    params.detection.fill_gaps = 9;
+    let out = on_detections(&params, 60, scene);
+    assert!(out.iter().all(|e| !(20..30).contains(&e.frame)));
 }
 
 /// A walker coming towards the camera, its box 3.5 px taller every frame, missed for 21 frames

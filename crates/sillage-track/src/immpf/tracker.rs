@@ -103,6 +103,9 @@ struct Track {
     age: u32,
     /// Estimates held until the tracker is confirmed (`confirm_frames`).
     held: Vec<PedestrianEstimate>,
+    /// The last estimate reported (detections-driven mode), where a filled gap starts
+    /// (`detection.fill_gaps`).
+    last_reported: Option<PedestrianEstimate>,
     /// Its foot point in its last `confirm_frames` frames, oldest first.
     recent_feet: VecDeque<(FrameIndex, Point2)>,
 }
@@ -528,6 +531,7 @@ impl PedestrianTracker {
             bbox: *person,
             age,
             held: Vec::new(),
+            last_reported: None,
             recent_feet: VecDeque::new(),
         }
     }

@@ -229,18 +229,71 @@ impl PedestrianTracker {
                 if !params.report_first_hits {
                     track.held.clear();
                 }
-                out.append(&mut track.held);
+                for estimate in std::mem::take(&mut track.held) {
+                    report(track, estimate, params.fill_gaps, out);
+                }
             }
             if !(observed || params.report_coasting && track.confirmed) {
                 continue;
             }
             let estimate = estimate_of(track, frame, models);
             if track.reported {
-                out.push(estimate);
+                report(track, estimate, params.fill_gaps, out);
             } else {
                 track.held.push(estimate);
             }
         }
+    }
+}
+
+/// Appends `estimate` of `track` to `out`, after the frames since the tracker's last reported
+/// estimate when there are at least one and at most `fill_gaps` of them ([`interpolated`]).
+fn report(
+    track: &mut Track,
+    estimate: PedestrianEstimate,
+    fill_gaps: u32,
+    out: &mut Vec<PedestrianEstimate>,
+) {
+    if let Some(before) = &track.last_reported {
+        let gap = estimate.frame.saturating_sub(before.frame + 1);
+        if gap > 0 && gap <= u64::from(fill_gaps) {
+            out.extend(
+                (before.frame + 1..estimate.frame).map(|f| interpolated(before, &estimate, f)),
+            );
+        }
+    }
+    track.last_reported = Some(estimate.clone());
+    out.push(estimate);
+}
+
+/// The estimate at `frame`, between those of the same tracker at `before.frame` and
+/// `after.frame`: box edges, sizes and model weights interpolated linearly, the velocity that
+/// of the foot point from one to the other.
+fn interpolated(
+    before: &PedestrianEstimate,
+    after: &PedestrianEstimate,
+    frame: FrameIndex,
+) -> PedestrianEstimate {
+    let span = (after.frame - before.frame) as f64;
+    let s = (frame - before.frame) as f64 / span;
+    let lerp = |a: f64, b: f64| a + s * (b - a);
+    let (a, b) = (&before.bbox, &after.bbox);
+    PedestrianEstimate {
+        frame,
+        track_id: after.track_id,
+        bbox: BoundingBox {
+            left_px: lerp(a.left_px, b.left_px),
+            top_px: lerp(a.top_px, b.top_px),
+            width_px: lerp(a.width_px, b.width_px),
+            height_px: lerp(a.height_px, b.height_px),
+        },
+        vel_px_per_frame: (b.foot() - a.foot()) / span,
+        model_weights: before
+            .model_weights
+            .iter()
+            .zip(&after.model_weights)
+            .map(|(&p, &q)| lerp(p, q))
+            .collect(),
     }
 }
 
