@@ -80,6 +80,7 @@ struct Summary {
     frames: u64,
     tracks: u64,
     rows: u64,
+    gap_rows: u64,
     ms_per_frame: f64,
     tracking_ms_per_frame: f64,
     out: String,
@@ -152,6 +153,7 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         frames: run.frames,
         tracks: run.tracks,
         rows: run.rows,
+        gap_rows: run.gap_rows,
         ms_per_frame: per_frame(run.total),
         tracking_ms_per_frame: per_frame(run.tracking),
         out: args.out.display().to_string(),
@@ -160,10 +162,12 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         eprintln!(
-            "{} frames, {} tracks, {} rows with {} → {} ({:.1} ms/frame, tracking {:.1} ms/frame)",
+            "{} frames, {} tracks, {} rows ({} over filled gaps) with {} → {} ({:.1} ms/frame, \
+             tracking {:.1} ms/frame)",
             summary.frames,
             summary.tracks,
             summary.rows,
+            summary.gap_rows,
             summary.models,
             summary.out,
             summary.ms_per_frame,

@@ -117,16 +117,23 @@ fn detections_alone_are_tracked_and_benched() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("det_only.txt");
     // The size comes from seqinfo.ini beside det/.
-    run_ok(&[
+    let summary = run_ok(&[
         "track",
         "immpf",
         "--detections",
         &format!("{PETS}/det/det.txt"),
         "--out",
         path_str(&out),
+        "--json",
     ]);
     let rows = fs::read_to_string(&out).unwrap().lines().count();
     assert!(rows > 500, "{rows} rows");
+    // The summary counts the rows written, and those of them interpolated over gaps: people
+    // the detector misses for a few frames are there (12 rows on these frames, seed 1).
+    let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert_eq!(summary["rows"].as_u64(), Some(rows as u64), "{summary}");
+    let gap_rows = summary["gap_rows"].as_u64().unwrap_or_else(|| panic!("{summary}"));
+    assert!(gap_rows > 0 && gap_rows < rows as u64 / 10, "{summary}");
     let table = run_ok(&[
         "bench",
         "immpf",

@@ -147,6 +147,8 @@ pub struct PedestrianTracker {
     last_frame: Option<FrameIndex>,
     /// The assignment solver of the detections-only mode, its buffers reused.
     solver: LapSolver,
+    /// Rows reported so far over the gaps `detection.fill_gaps` filled.
+    gap_rows: u64,
 }
 
 /// A confirmed tracker that died recently: where it was going, so that a birth on its way
@@ -205,6 +207,7 @@ impl PedestrianTracker {
             next_id: 1,
             last_frame: None,
             solver: LapSolver::new(),
+            gap_rows: 0,
         })
     }
 
@@ -216,6 +219,12 @@ impl PedestrianTracker {
     /// True when no tracker is alive.
     pub fn is_empty(&self) -> bool {
         self.tracks.is_empty()
+    }
+
+    /// Rows reported so far over the gaps that `detection.fill_gaps` filled (interpolated,
+    /// not measured).
+    pub fn gap_rows(&self) -> u64 {
+        self.gap_rows
     }
 
     /// Tracks one frame and appends to `out` the estimate of every confirmed tracker, preceded

@@ -55,6 +55,8 @@ pub struct ImmpfSummary {
     pub rows: u64,
     /// The largest track id reported (ids count from 1).
     pub tracks: u64,
+    /// Rows of `rows` interpolated over gaps (`tracker.detection.fill_gaps`), not measured.
+    pub gap_rows: u64,
     /// Wall time of the whole run.
     pub total: Duration,
     /// Time in the tracker's steps.
@@ -122,6 +124,7 @@ impl ImmpfRun {
             frames,
             rows,
             tracks: last_id,
+            gap_rows: self.tracker.gap_rows(),
             total: started.elapsed(),
             tracking,
         })

@@ -230,7 +230,7 @@ impl PedestrianTracker {
                     track.held.clear();
                 }
                 for estimate in std::mem::take(&mut track.held) {
-                    report(track, estimate, params.fill_gaps, out);
+                    self.gap_rows += report(track, estimate, params.fill_gaps, out);
                 }
             }
             if !(observed || params.report_coasting && track.confirmed) {
@@ -238,7 +238,7 @@ impl PedestrianTracker {
             }
             let estimate = estimate_of(track, frame, models);
             if track.reported {
-                report(track, estimate, params.fill_gaps, out);
+                self.gap_rows += report(track, estimate, params.fill_gaps, out);
             } else {
                 track.held.push(estimate);
             }
@@ -248,22 +248,26 @@ impl PedestrianTracker {
 
 /// Appends `estimate` of `track` to `out`, after the frames since the tracker's last reported
 /// estimate when there are at least one and at most `fill_gaps` of them ([`interpolated`]).
+/// Returns the number of those filled frames.
 fn report(
     track: &mut Track,
     estimate: PedestrianEstimate,
     fill_gaps: u32,
     out: &mut Vec<PedestrianEstimate>,
-) {
+) -> u64 {
+    let mut filled = 0;
     if let Some(before) = &track.last_reported {
         let gap = estimate.frame.saturating_sub(before.frame + 1);
         if gap > 0 && gap <= u64::from(fill_gaps) {
             out.extend(
                 (before.frame + 1..estimate.frame).map(|f| interpolated(before, &estimate, f)),
             );
+            filled = gap;
         }
     }
     track.last_reported = Some(estimate.clone());
     out.push(estimate);
+    filled
 }
 
 /// The estimate at `frame`, between those of the same tracker at `before.frame` and
