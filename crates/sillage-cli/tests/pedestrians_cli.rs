@@ -132,7 +132,9 @@ fn detections_alone_are_tracked_and_benched() {
     // the detector misses for a few frames are there (12 rows on these frames, seed 1).
     let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
     assert_eq!(summary["rows"].as_u64(), Some(rows as u64), "{summary}");
-    let gap_rows = summary["gap_rows"].as_u64().unwrap_or_else(|| panic!("{summary}"));
+    let gap_rows = summary["gap_rows"]
+        .as_u64()
+        .unwrap_or_else(|| panic!("{summary}"));
     assert!(gap_rows > 0 && gap_rows < rows as u64 / 10, "{summary}");
     let table = run_ok(&[
         "bench",

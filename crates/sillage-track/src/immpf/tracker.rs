@@ -228,7 +228,8 @@ impl PedestrianTracker {
     }
 
     /// Tracks one frame and appends to `out` the estimate of every confirmed tracker, preceded
-    /// by the held estimates of earlier frames of those confirmed at this frame.
+    /// by the held estimates of earlier frames of those confirmed at this frame (and, on
+    /// detections, by the rows of the gaps `detection.fill_gaps` fills).
     pub fn step(
         &mut self,
         frame: &PedestrianFrame<'_>,
