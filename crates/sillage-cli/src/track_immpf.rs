@@ -127,7 +127,10 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
     let mut overlays = args
         .overlay
         .as_deref()
-        .map(|dir| PedestrianOverlays::create(dir, &params.models))
+        .map(|dir| {
+            let lag = params.detection.smoothing_lag_frames();
+            PedestrianOverlays::create(dir, &params.models, lag)
+        })
         .transpose()?;
     let mut progress = FrameProgress::new(tracking.frames_expected(), "tracking");
     let run = tracking.run(&mut |prepared, estimates| -> Result<()> {
@@ -146,6 +149,9 @@ pub fn run(args: &TrackImmpfArgs) -> Result<()> {
     writer.finish()?;
     if let Some(w) = weights {
         w.finish()?;
+    }
+    if let Some(o) = overlays {
+        o.finish()?;
     }
     let per_frame = |d: std::time::Duration| 1e3 * d.as_secs_f64() / run.frames as f64;
     let summary = Summary {

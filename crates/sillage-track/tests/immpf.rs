@@ -155,6 +155,7 @@ fn run(params: &PedestrianParams, scene: Scene, seed: u64) -> Vec<PedestrianEsti
         };
         tracker.step(&observations, &mut out).unwrap();
     }
+    tracker.finish(&mut out);
     out
 }
 
@@ -332,6 +333,14 @@ fn frames_out_of_order_and_bad_parameters_are_refused() {
             .to_string();
         assert!(err.contains(key), "{growth}, {max}: {err}");
     }
+    for smooth in [-1.0, f64::NAN, 1e6] {
+        let mut bad = PedestrianParams::default();
+        bad.detection.smooth_frames = smooth;
+        let err = PedestrianTracker::new(&bad, BoxSizing::FromCandidate, None, (W, H), 1)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("detection.smooth_frames"), "{smooth}: {err}");
+    }
     let mut bad = PedestrianParams::default();
     bad.proposal.share = f64::NAN;
     let err = PedestrianTracker::new(&bad, BoxSizing::FromCandidate, None, (W, H), 1)
@@ -443,6 +452,7 @@ fn a_tracker_lost_as_a_duplicate_at_a_crossing_gives_its_identity_back() {
             };
             tracker.step(&observations, &mut out).unwrap();
         }
+        tracker.finish(&mut out);
         let mut ids: Vec<u64> = out.iter().map(|e| e.track_id).collect();
         ids.sort_unstable();
         ids.dedup();
@@ -571,6 +581,18 @@ fn on_candidates(
     candidates: impl Fn(u64) -> Vec<Candidate>,
     seed: u64,
 ) -> Vec<PedestrianEstimate> {
+    let (mut tracker, mut out) = stepped_on_candidates(params, frames, candidates, seed);
+    tracker.finish(&mut out);
+    out
+}
+
+/// [`on_candidates`] before `finish`: the tracker, and the estimates its steps wrote.
+fn stepped_on_candidates(
+    params: &PedestrianParams,
+    frames: u64,
+    candidates: impl Fn(u64) -> Vec<Candidate>,
+    seed: u64,
+) -> (PedestrianTracker, Vec<PedestrianEstimate>) {
     let mut tracker =
         PedestrianTracker::new(params, BoxSizing::FromCandidate, None, (W, H), seed).unwrap();
     let mut out = Vec::new();
@@ -584,7 +606,7 @@ fn on_candidates(
         };
         tracker.step(&observations, &mut out).unwrap();
     }
-    out
+    (tracker, out)
 }
 
 fn identities(estimates: &[PedestrianEstimate]) -> Vec<u64> {
@@ -678,6 +700,8 @@ fn a_gap_no_longer_than_fill_gaps_is_reported_interpolated() {
     let mut params = PedestrianParams::default();
     params.detection.lost_frames = 30;
     params.detection.fill_gaps = 10;
+    // The boxes as interpolated, before any smoothing (tested on its own below).
+    params.detection.smooth_frames = 0.0;
     let out = on_detections(&params, 60, scene);
     assert_eq!(identities(&out).len(), 1, "{:?}", identities(&out));
     let mut frames: Vec<u64> = out.iter().map(|e| e.frame).collect();
@@ -703,6 +727,52 @@ fn a_gap_no_longer_than_fill_gaps_is_reported_interpolated() {
     params.detection.fill_gaps = 9;
     let out = on_detections(&params, 60, scene);
     assert!(out.iter().all(|e| !(20..30).contains(&e.frame)));
+}
+
+/// A walker at 2 px a frame whose detections jitter by up to 3 px: with `smooth_frames` the
+/// reported boxes are written a few frames late, every frame exactly once (the last ones by
+/// `finish`), and their foot points lie closer to the walker than without.
+#[test]
+fn smoothed_boxes_are_written_once_each_and_closer_to_a_jittered_walker() {
+    let walker_x = |f: u64| 40.0 + 2.0 * f as f64;
+    let jitter = |f: u64| 3.0 * (2.3 * f as f64).sin();
+    let scene = |f: u64| vec![(walker_x(f) + jitter(f), 120.0, 0.9)];
+    let error = |smooth_frames: f64| {
+        let mut params = PedestrianParams::default();
+        params.detection.smooth_frames = smooth_frames;
+        let out = on_detections(&params, 60, scene);
+        let mut frames: Vec<u64> = out.iter().map(|e| e.frame).collect();
+        frames.sort_unstable();
+        assert_eq!(frames, (0..60).collect::<Vec<u64>>(), "σ {smooth_frames}");
+        let errors: Vec<f64> = out
+            .iter()
+            .filter(|e| (5..55).contains(&e.frame))
+            .map(|e| (e.bbox.foot().x - walker_x(e.frame)).abs())
+            .collect();
+        errors.iter().sum::<f64>() / errors.len() as f64
+    };
+    let (raw, smoothed) = (error(0.0), error(2.0));
+    assert!(
+        smoothed < 0.7 * raw,
+        "mean foot error {smoothed} px against {raw} px"
+    );
+    // Written late: at frame 30 of a walker held every frame, the last frame written is 26.
+    let mut params = PedestrianParams::default();
+    params.detection.smooth_frames = 2.0;
+    assert_eq!(params.detection.smoothing_lag_frames(), 4);
+    let candidates = |f: u64| {
+        scene(f)
+            .into_iter()
+            .map(|(x, y, score)| Candidate {
+                bbox: BoundingBox::standing_on(sillage_core::Point2::new(x, y), 16.0, 48.0),
+                score,
+            })
+            .collect()
+    };
+    let (mut tracker, mut out) = stepped_on_candidates(&params, 31, candidates, 1);
+    assert_eq!(out.iter().map(|e| e.frame).max(), Some(26));
+    tracker.finish(&mut out);
+    assert_eq!(out.iter().map(|e| e.frame).max(), Some(30));
 }
 
 /// A walker coming towards the camera, its box 3.5 px taller every frame, missed for 21 frames
@@ -837,6 +907,7 @@ fn meeting(params: &PedestrianParams, with_frames: bool, seed: u64) -> Vec<Pedes
         };
         tracker.step(&observations, &mut out).unwrap();
     }
+    tracker.finish(&mut out);
     out
 }
 

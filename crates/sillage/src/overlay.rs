@@ -5,7 +5,7 @@
 //! pedestrian overlays of `track immpf --overlay` (boxes, model-weight bars, trajectories
 //! coloured by the dominant model).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
 
 use sillage_core::{Detection, Error, FrameIndex, Result, RgbImage, TrackPoint};
@@ -88,29 +88,43 @@ pub fn write_overlays(
 }
 
 /// `sillage track immpf --overlay DIR`: draws each frame as the tracker goes, from the
-/// estimates of that frame (those reported late, at a track's confirmation, only join the
-/// trajectories), into `DIR/overlay_NNNNN.png` (1-based frame number).
+/// estimates of that frame, into `DIR/overlay_NNNNN.png` (1-based frame number). A frame is
+/// drawn `lag` frames late, when the tracker smooths its boxes and so writes them that late
+/// (`detection.smooth_frames`); estimates later still (those of a track's confirmation, or of
+/// a gap it filled) only join the trajectories.
 pub struct PedestrianOverlays {
     dir: PathBuf,
     models: Vec<&'static str>,
     trails: PedestrianTrails,
+    lag: usize,
+    /// Frames not drawn yet, oldest first, with the people estimated there so far.
+    pending: VecDeque<PendingOverlay>,
+}
+
+/// A frame waiting for the estimates of its people.
+struct PendingOverlay {
+    frame: FrameIndex,
+    colour: RgbImage,
     people: Vec<PersonOverlay>,
 }
 
 impl PedestrianOverlays {
-    /// Creates `dir` for the overlays of a tracker with `models`.
-    pub fn create(dir: &Path, models: &[ModelName]) -> Result<Self> {
+    /// Creates `dir` for the overlays of a tracker with `models` that writes the boxes of a
+    /// frame `lag` frames later.
+    pub fn create(dir: &Path, models: &[ModelName], lag: u64) -> Result<Self> {
         create_folder(dir)?;
         Ok(Self {
             dir: dir.to_path_buf(),
             models: models.iter().map(|m| m.label()).collect(),
             trails: PedestrianTrails::default(),
-            people: Vec::new(),
+            lag: usize::try_from(lag).unwrap_or(usize::MAX),
+            pending: VecDeque::new(),
         })
     }
 
-    /// Adds the `estimates` of a step to the trajectories and draws frame `frame` (0-based),
-    /// whose colour picture is `colour`, with the people estimated at that frame.
+    /// Adds the `estimates` of a step at frame `frame` (0-based), whose colour picture is
+    /// `colour`, and draws the frames that are `lag` frames old. The same frame handed again
+    /// (the tracker's last estimates, after the last frame) adds its estimates only.
     pub fn push(
         &mut self,
         frame: FrameIndex,
@@ -118,7 +132,13 @@ impl PedestrianOverlays {
         estimates: &[PedestrianEstimate],
     ) -> Result<()> {
         let colour = colour.ok_or_else(|| Error::input("overlays need the colour frames"))?;
-        self.people.clear();
+        if self.pending.back().is_none_or(|p| p.frame < frame) {
+            self.pending.push_back(PendingOverlay {
+                frame,
+                colour: colour.clone(),
+                people: Vec::new(),
+            });
+        }
         for e in estimates {
             let person = PersonOverlay {
                 track_id: e.track_id,
@@ -128,15 +148,39 @@ impl PedestrianOverlays {
                 height_px: e.bbox.height_px,
                 model_weights: e.model_weights.clone(),
             };
-            self.trails.record(e.frame, &person);
-            if e.frame == frame {
-                self.people.push(person);
+            match self.pending.iter_mut().find(|p| p.frame == e.frame) {
+                Some(pending) => pending.people.push(person),
+                None => self.trails.record(e.frame, &person),
             }
         }
-        let picture = draw_pedestrians(colour, &self.people, &self.trails, &self.models)
-            .map_err(|e| overlay_error(frame + 1, e))?;
+        while self.pending.len() > self.lag {
+            self.draw_oldest()?;
+        }
+        Ok(())
+    }
+
+    /// Draws the frames still waiting (after the last frame).
+    pub fn finish(mut self) -> Result<()> {
+        while !self.pending.is_empty() {
+            self.draw_oldest()?;
+        }
+        Ok(())
+    }
+
+    /// Draws the oldest waiting frame with its people, who join the trajectories.
+    fn draw_oldest(&mut self) -> Result<()> {
+        let Some(pending) = self.pending.pop_front() else {
+            return Ok(());
+        };
+        for person in &pending.people {
+            self.trails.record(pending.frame, person);
+        }
+        let picture =
+            draw_pedestrians(&pending.colour, &pending.people, &self.trails, &self.models)
+                .map_err(|e| overlay_error(pending.frame + 1, e))?;
         write_png_rgb(
-            self.dir.join(format!("overlay_{:05}.png", frame + 1)),
+            self.dir
+                .join(format!("overlay_{:05}.png", pending.frame + 1)),
             &picture,
         )
     }

@@ -6,6 +6,7 @@
 //! weigh them, with SORT's and ByteTrack's life cycle (`on_detections`).
 
 mod on_detections;
+mod smoothing;
 
 use std::collections::VecDeque;
 
@@ -108,6 +109,9 @@ struct Track {
     last_reported: Option<PedestrianEstimate>,
     /// Its foot point in its last `confirm_frames` frames, oldest first.
     recent_feet: VecDeque<(FrameIndex, Point2)>,
+    /// Its reported estimates not yet written (detection-driven mode,
+    /// `detection.smooth_frames`).
+    smoother: smoothing::BoxSmoother,
 }
 
 impl Track {
@@ -227,9 +231,22 @@ impl PedestrianTracker {
         self.gap_rows
     }
 
+    /// Appends to `out` the estimates still held back for `detection.smooth_frames` (those of
+    /// the last frames): call it once after the last frame; the tracker is done afterwards.
+    /// Nothing is held back without smoothing.
+    pub fn finish(&mut self, out: &mut Vec<PedestrianEstimate>) {
+        let kernel = self.smoothing_kernel();
+        for track in &mut self.tracks {
+            track.smoother.write_all(kernel, out);
+        }
+    }
+
     /// Tracks one frame and appends to `out` the estimate of every confirmed tracker, preceded
     /// by the held estimates of earlier frames of those confirmed at this frame (and, on
-    /// detections, by the rows of the gaps `detection.fill_gaps` fills).
+    /// detections, by the rows of the gaps `detection.fill_gaps` fills). With
+    /// `detection.smooth_frames`, the estimates come out smoothed, a few frames late
+    /// ([`DetectionLikelihoodParams::smoothing_lag_frames`]); [`PedestrianTracker::finish`]
+    /// gives the last ones.
     pub fn step(
         &mut self,
         frame: &PedestrianFrame<'_>,
@@ -543,6 +560,7 @@ impl PedestrianTracker {
             held: Vec::new(),
             last_reported: None,
             recent_feet: VecDeque::new(),
+            smoother: smoothing::BoxSmoother::default(),
         }
     }
 }

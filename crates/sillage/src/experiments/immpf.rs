@@ -251,6 +251,7 @@ impl Sequence {
         for frame in &self.frames {
             step(&mut tracker, frame, &mut estimates)?;
         }
+        tracker.finish(&mut estimates);
         let ms = 1e3 * started.elapsed().as_secs_f64() / self.frames.len().max(1) as f64;
         Ok((estimates, ms))
     }

@@ -97,7 +97,8 @@ impl ImmpfRun {
     }
 
     /// Tracks every frame, handing each with the estimates its step reported to
-    /// `on_frame`; an input without frames is an error.
+    /// `on_frame`, and the last frame a second time with the estimates the tracker still held
+    /// back (`detection.smooth_frames`; none without); an input without frames is an error.
     pub fn run<E: From<Error>>(
         mut self,
         on_frame: &mut EstimateSink<'_, E>,
@@ -106,19 +107,30 @@ impl ImmpfRun {
         let mut estimates = Vec::new();
         let started = Instant::now();
         let mut tracking = Duration::ZERO;
+        let mut last_frame: Option<PreparedFrame> = None;
         while let Some(prepared) = self.input.next_frame()? {
+            if let Some(done) = last_frame.take() {
+                self.input.recycle(done);
+            }
             estimates.clear();
             let tick = Instant::now();
             step(&mut self.tracker, &prepared, &mut estimates)?;
             tracking += tick.elapsed();
             on_frame(&prepared, &estimates)?;
-            self.input.recycle(prepared);
+            last_frame = Some(prepared);
             rows += estimates.len() as u64;
             last_id = estimates.iter().map(|e| e.track_id).fold(last_id, u64::max);
             frames += 1;
         }
-        if frames == 0 {
+        let Some(last_frame) = last_frame else {
             return Err(Error::input("the input holds no frame").into());
+        };
+        estimates.clear();
+        self.tracker.finish(&mut estimates);
+        if !estimates.is_empty() {
+            on_frame(&last_frame, &estimates)?;
+            rows += estimates.len() as u64;
+            last_id = estimates.iter().map(|e| e.track_id).fold(last_id, u64::max);
         }
         Ok(ImmpfSummary {
             frames,

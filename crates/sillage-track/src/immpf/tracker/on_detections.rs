@@ -57,7 +57,7 @@ impl PedestrianTracker {
         };
         let unmatched = self.match_in_two_stages(candidates, &looks);
         self.correct_on_detections(frame, cues);
-        self.end_lost_trackers();
+        self.end_lost_trackers(out);
         for d in unmatched {
             let candidate = candidates[d];
             self.next_id += 1;
@@ -200,13 +200,25 @@ impl PedestrianTracker {
     }
 
     /// Ends the tentative trackers that missed their detection, the confirmed ones that
-    /// went `lost_frames` frames without one, and those whose foot left the image.
-    fn end_lost_trackers(&mut self) {
+    /// went `lost_frames` frames without one, and those whose foot left the image; the
+    /// estimates they still held back for smoothing go to `out`.
+    fn end_lost_trackers(&mut self, out: &mut Vec<PedestrianEstimate>) {
         let (lost, frame_size) = (self.params.detection.lost_frames, self.frame_size_px);
-        self.tracks.retain(|t| {
+        let kernel = self.smoothing_kernel();
+        self.tracks.retain_mut(|t| {
             let limit = if t.confirmed { lost } else { 0 };
-            t.foot_inside(frame_size) && t.unsupported_frames <= limit
+            let alive = t.foot_inside(frame_size) && t.unsupported_frames <= limit;
+            if !alive {
+                t.smoother.write_all(kernel, out);
+            }
+            alive
         });
+    }
+
+    /// σ and reach, in frames, of the smoothing of the reported boxes.
+    pub(super) fn smoothing_kernel(&self) -> (f64, u64) {
+        let params = &self.params.detection;
+        (params.smooth_frames, params.smoothing_lag_frames())
     }
 
     /// Appends the estimate of every reported tracker that a detection holds at `frame`
@@ -230,7 +242,7 @@ impl PedestrianTracker {
                     track.held.clear();
                 }
                 for estimate in std::mem::take(&mut track.held) {
-                    self.gap_rows += report(track, estimate, params.fill_gaps, out);
+                    self.gap_rows += report(track, estimate, params, out);
                 }
             }
             if !(observed || params.report_coasting && track.confirmed) {
@@ -238,35 +250,62 @@ impl PedestrianTracker {
             }
             let estimate = estimate_of(track, frame, models);
             if track.reported {
-                self.gap_rows += report(track, estimate, params.fill_gaps, out);
+                self.gap_rows += report(track, estimate, params, out);
             } else {
                 track.held.push(estimate);
+            }
+        }
+        if params.smooth_frames > 0.0 {
+            self.write_smoothed(frame, out);
+        }
+    }
+
+    /// Writes the smoothed estimates that no later report can change: those `reach` frames
+    /// or more before a tracker's last reported one, and those so old that neither a filled
+    /// gap nor a confirmation's held frames could still reach within `reach` of them.
+    fn write_smoothed(&mut self, frame: FrameIndex, out: &mut Vec<PedestrianEstimate>) {
+        let kernel = self.smoothing_kernel();
+        let params = &self.params.detection;
+        let late = kernel.1 + u64::from(params.fill_gaps) + u64::from(params.min_hits);
+        for track in &mut self.tracks {
+            let Some(last) = track.smoother.last_frame() else {
+                continue;
+            };
+            let through = last.checked_sub(kernel.1).max(frame.checked_sub(late));
+            if let Some(through) = through {
+                track.smoother.write_through(through, kernel, out);
             }
         }
     }
 }
 
-/// Appends `estimate` of `track` to `out`, after the frames since the tracker's last reported
-/// estimate when there are at least one and at most `fill_gaps` of them ([`interpolated`]).
-/// Returns the number of those filled frames.
+/// Reports `estimate` of `track`, after the frames since the tracker's last reported
+/// estimate when there are at least one and at most `fill_gaps` of them ([`interpolated`]):
+/// appended to `out`, or to the tracker's smoother with `detection.smooth_frames`. Returns
+/// the number of those filled frames.
 fn report(
     track: &mut Track,
     estimate: PedestrianEstimate,
-    fill_gaps: u32,
+    params: &DetectionLikelihoodParams,
     out: &mut Vec<PedestrianEstimate>,
 ) -> u64 {
-    let mut filled = 0;
+    let mut rows = Vec::new();
     if let Some(before) = &track.last_reported {
         let gap = estimate.frame.saturating_sub(before.frame + 1);
-        if gap > 0 && gap <= u64::from(fill_gaps) {
-            out.extend(
+        if gap > 0 && gap <= u64::from(params.fill_gaps) {
+            rows.extend(
                 (before.frame + 1..estimate.frame).map(|f| interpolated(before, &estimate, f)),
             );
-            filled = gap;
         }
     }
+    let filled = rows.len() as u64;
     track.last_reported = Some(estimate.clone());
-    out.push(estimate);
+    rows.push(estimate);
+    if params.smooth_frames > 0.0 {
+        rows.into_iter().for_each(|row| track.smoother.push(row));
+    } else {
+        out.append(&mut rows);
+    }
     filled
 }
 
