@@ -929,30 +929,35 @@ fn meeting_identities(estimates: &[PedestrianEstimate]) -> Vec<(u64, usize)> {
 }
 
 /// Detections beside frames drive the trackers as detections alone do: with the colour
-/// weight at 0 the frames change nothing, estimate for estimate.
+/// weight set to 0 the frames change nothing, estimate for estimate.
 #[test]
 fn detections_beside_frames_track_as_detections_alone_without_colour() {
-    let params = PedestrianParams::default();
-    assert_eq!(params.detection.colour_weight, 0.0);
+    let mut params = PedestrianParams::default();
+    params.detection.colour_weight = 0.0;
     assert_eq!(meeting(&params, true, 4), meeting(&params, false, 4));
 }
 
 /// Two walkers meet face to face and walk back: the predicted boxes carry on into each
 /// other, and the first detections after the turn overlap both equally, so on IoU alone the
-/// identities swap for some seeds; with the colour distance in the assignment each tracker
-/// keeps its own walker for every seed.
+/// identities swap for some seeds; with the colour distance in the assignment (weight 1, or
+/// the default) each tracker keeps its own walker for every seed.
 #[test]
 fn colour_in_the_assignment_keeps_identities_when_walkers_meet_and_turn_back() {
     let mut params = PedestrianParams::default();
+    let default_weight = params.detection.colour_weight;
+    assert!(default_weight > 0.0);
     params.detection.min_hits = 3;
+    params.detection.colour_weight = 0.0;
     let own = [(1, 0), (2, 1)];
     let swapped = (1..=6)
         .filter(|&seed| meeting_identities(&meeting(&params, true, seed)) != own)
         .count();
     assert!(swapped > 0, "on IoU alone no seed of six swapped");
-    params.detection.colour_weight = 1.0;
-    for seed in 1..=6 {
-        let pairs = meeting_identities(&meeting(&params, true, seed));
-        assert_eq!(pairs, own, "seed {seed}");
+    for weight in [1.0, default_weight] {
+        params.detection.colour_weight = weight;
+        for seed in 1..=6 {
+            let pairs = meeting_identities(&meeting(&params, true, seed));
+            assert_eq!(pairs, own, "weight {weight}, seed {seed}");
+        }
     }
 }
