@@ -116,6 +116,13 @@ impl PedestrianTracker {
         min_iou: f64,
     ) -> (Vec<usize>, Vec<usize>) {
         let weight = self.params.detection.colour_weight;
+        // The most the colour term can add: w (d² ≤ 1) where detections have a look (with
+        // frames), nothing without.
+        let colour_bound = if pool.looks.iter().any(Option::is_some) {
+            weight
+        } else {
+            0.0
+        };
         let costs: Vec<f64> = tracks
             .iter()
             .flat_map(|&t| dets.iter().map(move |&d| (t, d)))
@@ -138,7 +145,7 @@ impl PedestrianTracker {
             tracks.len(),
             dets.len(),
             &costs,
-            1.0 - min_iou + weight,
+            1.0 - min_iou + colour_bound,
         );
         let mut track_taken = vec![false; tracks.len()];
         let mut det_taken = vec![false; dets.len()];
