@@ -151,13 +151,16 @@ mod tests {
         smoother.write_all((1.0, 2), &mut out);
         let frames: Vec<u64> = out.iter().map(|e| e.frame).collect();
         assert_eq!(frames, (0..10).collect::<Vec<_>>());
-        // Away from the jitter and the ends, a straight walk is unchanged.
-        assert!((out[2].bbox.left_px - 4.0).abs() < 1e-12);
-        // The jitter is spread: frame 5 moves well under its 6 px, its neighbours a little.
+        // Away from the jitter a straight walk is unchanged, at its ends too (the local line
+        // carries the trend where a mean would pull the box inwards).
         let off = |f: usize| out[f].bbox.left_px - 2.0 * f as f64;
+        for f in [0, 1, 2, 8, 9] {
+            assert!(off(f).abs() < 1e-9, "frame {f}: {}", off(f));
+        }
+        // The jitter is spread: frame 5 moves well under its 6 px, its neighbours a little.
         assert!(off(5) > 1.0 && off(5) < 3.0, "{}", off(5));
         assert!(off(4) > 0.5 && off(4) < off(5));
-        assert_eq!(out[5].bbox.width_px, 20.0);
+        assert!((out[5].bbox.width_px - 20.0).abs() < 1e-9);
         // Only the rows within reach of the next one to write are kept.
         assert!(smoother.rows.is_empty() || smoother.written == smoother.rows.len());
     }
