@@ -59,6 +59,50 @@ fn overlays_of_the_first_pets_frames_are_written_one_per_frame() {
     assert_eq!(last.get_pixel(760, 8).0, [0, 0, 0]);
 }
 
+/// With detections beside the frames the boxes are smoothed and written four frames late
+/// (`detection.smooth_frames`): the overlays wait for them, so every frame with result rows,
+/// the last ones included (written when the input ends), shows its boxes.
+#[test]
+fn overlays_wait_for_the_smoothed_boxes() {
+    let dir = tempfile::tempdir().unwrap();
+    let overlays = dir.path().join("overlays");
+    let results = dir.path().join("results.txt");
+    let detections = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/pets09_s2l1/det/det.txt"
+    );
+    let output = sillage(&[
+        "track",
+        "immpf",
+        PETS_FRAMES,
+        "--detections",
+        detections,
+        "--max-frames",
+        "12",
+        "--out",
+        path_str(&results),
+        "--overlay",
+        path_str(&overlays),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let rows = std::fs::read_to_string(&results).unwrap();
+    let mut frames_with_rows = 0;
+    for f in 1..=12 {
+        let picture = image::open(overlays.join(format!("overlay_{f:05}.png")))
+            .unwrap()
+            .to_rgb8();
+        let box_pixels = picture.pixels().filter(|p| p.0 == BOX_RGB).count();
+        let tracked = rows.lines().any(|l| l.starts_with(&format!("{f},")));
+        frames_with_rows += usize::from(tracked);
+        assert_eq!(
+            box_pixels > 100,
+            tracked,
+            "frame {f}: {box_pixels} box pixels"
+        );
+    }
+    assert!(frames_with_rows >= 6, "{rows}");
+}
+
 #[test]
 fn overlays_need_frames() {
     let dir = tempfile::tempdir().unwrap();

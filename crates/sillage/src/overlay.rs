@@ -123,8 +123,8 @@ impl PedestrianOverlays {
     }
 
     /// Adds the `estimates` of a step at frame `frame` (0-based), whose colour picture is
-    /// `colour`, and draws the frames that are `lag` frames old. The same frame handed again
-    /// (the tracker's last estimates, after the last frame) adds its estimates only.
+    /// `colour`, and draws the frames that are `lag` frames old (a frame handed twice adds
+    /// its estimates to the first).
     pub fn push(
         &mut self,
         frame: FrameIndex,

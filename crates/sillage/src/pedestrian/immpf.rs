@@ -96,42 +96,38 @@ impl ImmpfRun {
         self.input.len
     }
 
-    /// Tracks every frame, handing each with the estimates its step reported to
-    /// `on_frame`, and the last frame a second time with the estimates the tracker still held
-    /// back (`detection.smooth_frames`; none without); an input without frames is an error.
+    /// Tracks every frame, handing each with the estimates its step reported to `on_frame`
+    /// (once per frame, one frame late; the last frame with the estimates the tracker still
+    /// held back too, `detection.smooth_frames`); an input without frames is an error.
     pub fn run<E: From<Error>>(
         mut self,
         on_frame: &mut EstimateSink<'_, E>,
     ) -> Result<ImmpfSummary, E> {
         let (mut frames, mut rows, mut last_id) = (0u64, 0u64, 0u64);
-        let mut estimates = Vec::new();
         let started = Instant::now();
         let mut tracking = Duration::ZERO;
-        let mut last_frame: Option<PreparedFrame> = None;
+        let mut hand_over = |prepared: &PreparedFrame, estimates: &[PedestrianEstimate]| {
+            rows += estimates.len() as u64;
+            last_id = estimates.iter().map(|e| e.track_id).fold(last_id, u64::max);
+            on_frame(prepared, estimates)
+        };
+        let mut pending: Option<(PreparedFrame, Vec<PedestrianEstimate>)> = None;
         while let Some(prepared) = self.input.next_frame()? {
-            if let Some(done) = last_frame.take() {
-                self.input.recycle(done);
-            }
-            estimates.clear();
+            let mut estimates = Vec::new();
             let tick = Instant::now();
             step(&mut self.tracker, &prepared, &mut estimates)?;
             tracking += tick.elapsed();
-            on_frame(&prepared, &estimates)?;
-            last_frame = Some(prepared);
-            rows += estimates.len() as u64;
-            last_id = estimates.iter().map(|e| e.track_id).fold(last_id, u64::max);
             frames += 1;
+            if let Some((done, done_estimates)) = pending.replace((prepared, estimates)) {
+                hand_over(&done, &done_estimates)?;
+                self.input.recycle(done);
+            }
         }
-        let Some(last_frame) = last_frame else {
+        let Some((last, mut estimates)) = pending else {
             return Err(Error::input("the input holds no frame").into());
         };
-        estimates.clear();
         self.tracker.finish(&mut estimates);
-        if !estimates.is_empty() {
-            on_frame(&last_frame, &estimates)?;
-            rows += estimates.len() as u64;
-            last_id = estimates.iter().map(|e| e.track_id).fold(last_id, u64::max);
-        }
+        hand_over(&last, &estimates)?;
         Ok(ImmpfSummary {
             frames,
             rows,
