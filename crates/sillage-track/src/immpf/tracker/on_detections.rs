@@ -267,9 +267,11 @@ impl PedestrianTracker {
         }
     }
 
-    /// Writes the smoothed estimates that no later report can change: those `reach` frames
-    /// or more before a tracker's last reported one, and those so old that neither a filled
-    /// gap nor a confirmation's held frames could still reach within `reach` of them.
+    /// Writes the smoothed estimates that later reports will not change: those `reach` frames
+    /// or more before a tracker's last reported one (later ones come after it), and those
+    /// older than `reach + fill_gaps + min_hits` frames, which bounds how far back a filled
+    /// gap before a re-confirmation's streak reaches. (A re-confirmation after broken streaks
+    /// may report older held frames; a box near them is then smoothed without them.)
     fn write_smoothed(&mut self, frame: FrameIndex, out: &mut Vec<PedestrianEstimate>) {
         let kernel = self.smoothing_kernel();
         let params = &self.params.detection;
