@@ -4,6 +4,8 @@
 
 mod common;
 
+use std::path::PathBuf;
+
 use common::{path_str, sillage, stderr};
 
 const PETS_FRAMES: &str = concat!(
@@ -14,25 +16,29 @@ const PETS_FRAMES: &str = concat!(
 /// The colour of the boxes on pedestrian overlays.
 const BOX_RGB: [u8; 3] = [255, 215, 0];
 
-#[test]
-fn overlays_of_the_first_pets_frames_are_written_one_per_frame() {
+/// `sillage track immpf` on the first 12 PETS frames with `extra` options, overlays
+/// requested: the folder (kept alive by the returned temporary folder), and the results.
+fn track_with_overlays(extra: &[&str]) -> (tempfile::TempDir, PathBuf, String) {
     let dir = tempfile::tempdir().unwrap();
     let overlays = dir.path().join("overlays");
     let results = dir.path().join("results.txt");
-    let output = sillage(&[
-        "track",
-        "immpf",
-        PETS_FRAMES,
-        "--models",
-        "CP_CV_CA",
-        "--max-frames",
-        "12",
+    let mut args = vec!["track", "immpf", PETS_FRAMES, "--max-frames", "12"];
+    args.extend_from_slice(extra);
+    args.extend([
         "--out",
         path_str(&results),
         "--overlay",
         path_str(&overlays),
     ]);
+    let output = sillage(&args);
     assert!(output.status.success(), "{}", stderr(&output));
+    let rows = std::fs::read_to_string(&results).unwrap();
+    (dir, overlays, rows)
+}
+
+#[test]
+fn overlays_of_the_first_pets_frames_are_written_one_per_frame() {
+    let (_dir, overlays, rows) = track_with_overlays(&["--models", "CP_CV_CA"]);
     let mut names: Vec<String> = std::fs::read_dir(&overlays)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -45,7 +51,6 @@ fn overlays_of_the_first_pets_frames_are_written_one_per_frame() {
         assert_eq!(picture.dimensions(), (768, 576), "{name}");
     }
     // The frames with result rows show boxes; the legend's black strip is in the corner.
-    let rows = std::fs::read_to_string(&results).unwrap();
     let last = image::open(overlays.join("overlay_00012.png"))
         .unwrap()
         .to_rgb8();
@@ -64,28 +69,11 @@ fn overlays_of_the_first_pets_frames_are_written_one_per_frame() {
 /// the last ones included (written when the input ends), shows its boxes.
 #[test]
 fn overlays_wait_for_the_smoothed_boxes() {
-    let dir = tempfile::tempdir().unwrap();
-    let overlays = dir.path().join("overlays");
-    let results = dir.path().join("results.txt");
     let detections = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../../shared/data/pets09_s2l1/det/det.txt"
     );
-    let output = sillage(&[
-        "track",
-        "immpf",
-        PETS_FRAMES,
-        "--detections",
-        detections,
-        "--max-frames",
-        "12",
-        "--out",
-        path_str(&results),
-        "--overlay",
-        path_str(&overlays),
-    ]);
-    assert!(output.status.success(), "{}", stderr(&output));
-    let rows = std::fs::read_to_string(&results).unwrap();
+    let (_dir, overlays, rows) = track_with_overlays(&["--detections", detections]);
     let mut frames_with_rows = 0;
     for f in 1..=12 {
         let picture = image::open(overlays.join(format!("overlay_{f:05}.png")))

@@ -112,8 +112,10 @@ impl ImmpfRun {
             on_frame(prepared, estimates)
         };
         let mut pending: Option<(PreparedFrame, Vec<PedestrianEstimate>)> = None;
+        let mut spare = Vec::new();
         while let Some(prepared) = self.input.next_frame()? {
-            let mut estimates = Vec::new();
+            let mut estimates: Vec<PedestrianEstimate> = std::mem::take(&mut spare);
+            estimates.clear();
             let tick = Instant::now();
             step(&mut self.tracker, &prepared, &mut estimates)?;
             tracking += tick.elapsed();
@@ -121,6 +123,7 @@ impl ImmpfRun {
             if let Some((done, done_estimates)) = pending.replace((prepared, estimates)) {
                 hand_over(&done, &done_estimates)?;
                 self.input.recycle(done);
+                spare = done_estimates;
             }
         }
         let Some((last, mut estimates)) = pending else {

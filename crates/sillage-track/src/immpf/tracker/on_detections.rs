@@ -298,23 +298,25 @@ fn report(
     params: &DetectionLikelihoodParams,
     out: &mut Vec<PedestrianEstimate>,
 ) -> u64 {
-    let mut rows = Vec::new();
+    let smooth = params.smooth_frames > 0.0;
+    let mut emit = |row: PedestrianEstimate| {
+        if smooth {
+            track.smoother.push(row);
+        } else {
+            out.push(row);
+        }
+    };
+    let mut filled = 0;
     if let Some(before) = &track.last_reported {
         let gap = estimate.frame.saturating_sub(before.frame + 1);
         if gap > 0 && gap <= u64::from(params.fill_gaps) {
-            rows.extend(
-                (before.frame + 1..estimate.frame).map(|f| interpolated(before, &estimate, f)),
-            );
+            (before.frame + 1..estimate.frame)
+                .for_each(|f| emit(interpolated(before, &estimate, f)));
+            filled = gap;
         }
     }
-    let filled = rows.len() as u64;
-    track.last_reported = Some(estimate.clone());
-    rows.push(estimate);
-    if params.smooth_frames > 0.0 {
-        rows.into_iter().for_each(|row| track.smoother.push(row));
-    } else {
-        out.append(&mut rows);
-    }
+    emit(estimate.clone());
+    track.last_reported = Some(estimate);
     filled
 }
 
