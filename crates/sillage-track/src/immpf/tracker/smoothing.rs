@@ -2,11 +2,12 @@
 //! mode, `detection.smooth_frames`): each reported box becomes the value at its frame of a
 //! line fitted to the tracker's reported boxes within `reach` frames of it, weighted by a
 //! Gaussian of the frame distance (σ = `smooth_frames`; `reach` =
-//! [`crate::immpf::DetectionLikelihoodParams::smoothing_lag_frames`]). This is the Gaussian-smoothed interpolation StrongSORT's authors
-//! run on their output files (Du et al. 2023, "GSI", there with a Gaussian process), done as
-//! the tracker runs: a box is written once no box of the tracker can still arrive within
-//! `reach` frames of it. Detections place boxes with a noise of their own from frame to
-//! frame; averaging neighbours cancels part of it while a person walks at a steady pace.
+//! [`crate::immpf::DetectionLikelihoodParams::smoothing_lag_frames`]). This is the
+//! Gaussian-smoothed interpolation StrongSORT's authors run on their output files (Du et al.
+//! 2023, "GSI", there with a Gaussian process), done as the tracker runs: the tracker says
+//! when a box is final (`write_smoothed` in `on_detections`). Detections place boxes with a
+//! noise of their own from frame to frame; averaging neighbours cancels part of it while a
+//! person walks at a steady pace.
 
 use std::collections::VecDeque;
 
