@@ -2,11 +2,11 @@
 //!
 //! The Box–Muller transform (Box & Muller 1958): two uniforms `U₁` in `(0, 1]` and `U₂` in
 //! `[0, 1)` give the independent pair `√(−2 ln U₁)·(cos 2πU₂, sin 2πU₂)`. Each uniform is one
-//! 32-bit word from [`LANES`] xoshiro128++ generators stepped side by side, seeded from the
+//! 32-bit word from `LANES` xoshiro128++ generators stepped side by side, seeded from the
 //! target's own stream the first time a [`Normals`] needs them; the radius is therefore
 //! bounded by √(64 ln 2) ≈ 6.66 (a larger radius has probability 2⁻³² ≈ 2.3·10⁻¹⁰ per pair).
 //!
-//! A block of [`BLOCK`] pairs is drawn at once in one branch-free loop (no table, no
+//! A block of `BLOCK` pairs is drawn at once in one branch-free loop (no table, no
 //! rejection), which the compiler vectorises: AVX-512 or AVX2 where the CPU has them, with the
 //! same bits on every path. The logarithm, cosine and sine are single precision (errors below
 //! 3·10⁻⁷, far below any noise they scale), which doubles the lanes per vector; the draws are

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use sillage_core::{Error, Result};
 
 /// A file being written as `.NAME.partial` beside its final `path` (or, for a device or a
-/// pipe, into `path` itself: [`writes_in_place`]).
+/// pipe, into `path` itself: `writes_in_place`).
 ///
 /// Dropping it without [`PartialFile::commit`] leaves the partial file in place: after an
 /// interrupted run it holds every row written so far.

@@ -13,7 +13,7 @@
 //! bin: value `(r·4 + c)·8 + o` holds row cell `r` (along the keypoint direction turned by
 //! +90°, i.e. clockwise on screen), column cell `c` (along the keypoint direction), and
 //! direction bin `o` of `θ_keypoint − θ_gradient` (directions measured as in
-//! [`orientation`](super::orientation)). One departure: OpenCV centres the window on the
+//! `orientation`). One departure: OpenCV centres the window on the
 //! keypoint rounded to whole octave px; here it sits at the exact position, so a descriptor
 //! varies smoothly with the position (the particle filter of SIFT-PF samples positions).
 

@@ -2,10 +2,10 @@
 //! keypoints", IJCV 60(2)), following OpenCV's `SIFT` step by step, for the SIFT-PF tracker
 //! (Souded et al. 2011), whose particles each need a descriptor at an arbitrary position.
 //!
-//! [`SiftDetector::analyse`] builds the scale space of a frame once ([`pyramid`]: Gaussian
+//! [`SiftDetector::analyse`] builds the scale space of a frame once (`pyramid`: Gaussian
 //! octaves, DoG, gradient magnitude and direction of the levels keypoints use); then
-//! [`keypoints`](SiftDetector::keypoints) finds and refines DoG extrema ([`extrema`]) and
-//! gives each orientation peak a keypoint ([`orientation`]), and
+//! [`keypoints`](SiftDetector::keypoints) finds and refines DoG extrema (`extrema`) and
+//! gives each orientation peak a keypoint (`orientation`), and
 //! [`describe_at`](SiftDetector::describe_at) computes a descriptor ([`descriptor`]) at any
 //! position, scale and orientation from the stored gradients, cheaply enough for thousands of
 //! particles per frame.

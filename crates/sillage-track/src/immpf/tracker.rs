@@ -245,7 +245,7 @@ impl PedestrianTracker {
     /// by the held estimates of earlier frames of those confirmed at this frame (and, on
     /// detections, by the rows of the gaps `detection.fill_gaps` fills). With
     /// `detection.smooth_frames`, the estimates come out smoothed, a few frames late
-    /// ([`DetectionLikelihoodParams::smoothing_lag_frames`]); [`PedestrianTracker::finish`]
+    /// ([`crate::immpf::DetectionLikelihoodParams::smoothing_lag_frames`]); [`PedestrianTracker::finish`]
     /// gives the last ones.
     pub fn step(
         &mut self,

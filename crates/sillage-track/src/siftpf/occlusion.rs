@@ -32,7 +32,7 @@ pub struct ResumeCandidate {
 }
 
 /// The share of `signature`'s descriptors whose nearest neighbour among `candidates` passes
-/// Lowe's ratio test (`d₁ < ratio·d₂`) within [`MATCH_MAX_DISTANCE`].
+/// Lowe's ratio test (`d₁ < ratio·d₂`) within `MATCH_MAX_DISTANCE`.
 pub fn matched_share(
     signature: &[SiftDescriptor],
     candidates: &[SiftDescriptor],

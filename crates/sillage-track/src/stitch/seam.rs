@@ -127,7 +127,7 @@ type OverlapFrames = BTreeMap<FrameIndex, FramePoints>;
 
 /// Joins the windows whose edges are `earlier` and `later` at their seam: pairs the tracks of
 /// the overlap by `solver` (as many pairs as allowed, then the least total cost; see
-/// [`pair_cost`]) and decides which points of each window stay on the other's side of the
+/// `pair_cost`) and decides which points of each window stay on the other's side of the
 /// cut. A paired track keeps its partner's point where it has none on its own side; an
 /// unpaired track's points there stay unless the other window has a point within
 /// [`StitchParams::same_px`] in that frame (the overlap's duplicates); a track of the later

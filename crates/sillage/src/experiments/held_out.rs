@@ -199,7 +199,7 @@ pub enum HeldOutProgress<'a> {
     Bench(BenchProgress<'a>),
 }
 
-/// [`bench`] of the model combination `models` on every sequence folder for every combination
+/// [`bench`](fn@bench) of the model combination `models` on every sequence folder for every combination
 /// of `axes` (each applied as `--set` overrides after `config` and `overrides`), then
 /// [`choose_and_report`] by `split`.
 #[allow(clippy::too_many_arguments)]

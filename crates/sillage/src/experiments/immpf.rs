@@ -103,7 +103,7 @@ pub struct BenchInput {
     pub skip_baselines: bool,
 }
 
-/// What [`bench`] reports as it goes.
+/// What [`bench`](fn@bench) reports as it goes.
 pub enum BenchProgress<'a> {
     /// A sequence is read and prepared.
     Prepared {
@@ -120,7 +120,7 @@ pub enum BenchProgress<'a> {
 /// the seeds `1..=runs` (run in parallel), then SORT and ByteTrack on the sequence's
 /// `det/det.txt`, when it has one, over the same frames (rows `SORT`, `ByteTrack`). Without
 /// a motion prior in `scene`, MP uses one learned from the sequence's own CV_CA tracks
-/// ([`self_prior`]).
+/// (`self_prior`).
 pub fn bench(
     folders: &[impl AsRef<Path>],
     input: BenchInput,

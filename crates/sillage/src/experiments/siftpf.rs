@@ -174,7 +174,7 @@ pub struct Report {
     pub combined: Vec<Row>,
 }
 
-/// What [`bench`] reports as it goes.
+/// What [`bench`](fn@bench) reports as it goes.
 pub enum BenchProgress<'a> {
     /// A frame of a run is tracked; the number of frames the run expects, when known.
     Frame(Option<usize>),
