@@ -100,9 +100,12 @@ pub fn run(args: &PtvArgs) -> Result<()> {
         eprintln!("background initialised from the mean of the first {used} frames");
     }
     if let Some(calibration) = run.calibration()
-        && calibration.measured.is_some()
+        && let Some(measured) = &calibration.measured
     {
         eprintln!("{calibration}");
+        if let Some(warning) = measured.density_warning() {
+            eprintln!("warning: {warning}");
+        }
     }
     if let Some(window) = args.windows.window {
         return run_windowed(args, run, format, window);

@@ -90,6 +90,11 @@ fn synth_track_and_eval_round_trip() {
     let summary: serde_json::Value =
         serde_json::from_slice(&out.stdout).expect("--json prints JSON");
     assert_eq!(summary["frames"], 8);
+    let density = summary["detector"]["measured"]["source_density"]
+        .as_f64()
+        .expect("the measured source density in --json");
+    assert!(density > 0.0 && density < 0.1, "source density {density}");
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
     let text = fs::read_to_string(&tracks).unwrap();
     let header: Vec<&str> = text.lines().take(3).collect();
     assert!(header[0].starts_with("# TracTrac"), "{}", header[0]);
@@ -115,6 +120,28 @@ fn synth_track_and_eval_round_trip() {
     let false_rate = accuracy["false_recovery_rate"].as_f64().unwrap();
     assert!(true_rate > 0.8, "true recovery {true_rate}");
     assert!(false_rate < 0.1, "false recovery {false_rate}");
+}
+
+#[test]
+fn particle_images_too_dense_for_ptv_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = dir.path().join("dense");
+    // 0.05 particles per pixel: the images of the vortex's particles cover the frame.
+    synth_vortex(&frames, 3, 3000, 256, 4);
+    let tracks = dir.path().join("dense_track.txt");
+    let out = sillage(&["ptv", path_str(&frames), "--out", path_str(&tracks)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(
+        message.contains("warning: the particle images cover the frame (source density"),
+        "{message}"
+    );
+    let header = fs::read_to_string(&tracks).unwrap();
+    assert!(
+        header.contains("detector.measured.source_density"),
+        "{}",
+        header.lines().take(5).collect::<Vec<_>>().join("\n")
+    );
 }
 
 #[test]

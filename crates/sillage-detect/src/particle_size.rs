@@ -45,7 +45,42 @@ pub struct ParticleImages {
     pub blobs: usize,
     /// Blobs of the other polarity (for the record: a clear choice has far fewer).
     pub blobs_other_polarity: usize,
+    /// The source density `N_s`: the blobs per pixel of the measured region times the area
+    /// `π(2σ)²` of a particle image (its e⁻² disc). Particle images overlap, and PTV can no
+    /// longer separate them, as it nears 1 (see [`DENSE_SOURCE_DENSITY`]). Blobs that merge
+    /// are counted once, so it reads low on saturated frames, never above about π.
+    #[serde(default)]
+    pub source_density: f64,
 }
+
+impl ParticleImages {
+    /// A warning for run summaries when the source density reaches
+    /// [`DENSE_SOURCE_DENSITY`]; `None` below it.
+    pub fn density_warning(&self) -> Option<String> {
+        (self.source_density >= DENSE_SOURCE_DENSITY).then(|| {
+            format!(
+                "the particle images cover the frame (source density {:.2}: {} blobs of σ {:.2} \
+                 px on the first frame); PTV cannot separate particles this dense, and most \
+                 trajectories will be false. Record with fewer particles or smaller images, or \
+                 measure the flow by cross-correlation (PIV)",
+                self.source_density, self.blobs, self.sigma_px
+            )
+        })
+    }
+}
+
+/// Source density (as measured, [`ParticleImages::source_density`]) from which
+/// [`ParticleImages::density_warning`] warns.
+///
+/// Chosen on the tune halves of both `sillage bench ptv-accuracy` families (36 cases,
+/// 2026-11-30): the cases PTV still solves there measure at most 0.40 (defaults ≥ 54 % true
+/// recoveries), those beyond it (≤ 9 % true for the defaults, ≤ 0.1 % for the best of the
+/// grid) at least 0.60; 0.5 lies between. On the report halves (36 cases, never used to
+/// choose) it warns on all five cases whose defaults recover ≤ 8 % (measured 0.60–0.75, false
+/// recoveries 21–98 %) and on none of the other 31 (the densest of those measures 0.48 and
+/// recovers 53 %). Merged images count once, so the measure reads low where images overlap:
+/// 0.60 was a true `N_s` of 0.9–1.0, 0.75 one of 5.6.
+pub const DENSE_SOURCE_DENSITY: f64 = 0.5;
 
 /// One maximum over position and scale.
 #[derive(Debug, Clone, Copy)]
@@ -123,11 +158,14 @@ pub fn measure_particle_images(image: &GrayImage) -> Result<ParticleImages> {
     let half = chosen.len().div_ceil(2);
     let strong = &mut chosen[..half];
     strong.sort_by(|a, b| a.sigma_px.total_cmp(&b.sigma_px));
+    let sigma_px = strong[strong.len() / 2].sigma_px;
+    let disc_px2 = std::f64::consts::PI * (2.0 * sigma_px).powi(2);
     Ok(ParticleImages {
-        sigma_px: strong[strong.len() / 2].sigma_px,
+        sigma_px,
         polarity,
         blobs: chosen.len(),
         blobs_other_polarity: other,
+        source_density: chosen.len() as f64 * disc_px2 / (width * height) as f64,
     })
 }
 
@@ -335,6 +373,51 @@ mod tests {
                 assert!((m.sigma_px / sigma - 1.0).abs() < 0.15, "σ {sigma}: {m:?}");
             }
         }
+    }
+
+    /// `count` spots of std `sigma` at positions from a fixed sequence on a `side`² frame,
+    /// with a little noise.
+    fn random_spots(count: usize, sigma: f64, side: usize) -> GrayImage {
+        let mut image = uniform_noise(side, side, 11);
+        image.as_mut_slice().iter_mut().for_each(|v| *v *= 0.02);
+        let positions = uniform_noise(2 * count, 1, 5);
+        let reach = (4.0 * sigma).ceil() as isize;
+        for k in 0..count {
+            let cx = f64::from(positions.get(2 * k, 0)) * side as f64;
+            let cy = f64::from(positions.get(2 * k + 1, 0)) * side as f64;
+            for dy in -reach..=reach {
+                for dx in -reach..=reach {
+                    let (x, y) = (cx as isize + dx, cy as isize + dy);
+                    if x < 0 || y < 0 || x >= side as isize || y >= side as isize {
+                        continue;
+                    }
+                    let (x, y) = (x as usize, y as usize);
+                    let r2 = (x as f64 - cx).powi(2) + (y as f64 - cy).powi(2);
+                    let v = image.get(x, y) + 0.5 * (-r2 / (2.0 * sigma * sigma)).exp() as f32;
+                    image.set(x, y, v);
+                }
+            }
+        }
+        image
+    }
+
+    #[test]
+    fn the_source_density_separates_sparse_particles_from_a_saturated_frame() {
+        // 0.002 particles per pixel of σ 1.5 px: N_s = 0.002 · 4π · 1.5² ≈ 0.057.
+        let sparse = measure_particle_images(&random_spots(51, 1.5, 160)).unwrap();
+        assert!(
+            (0.03..0.09).contains(&sparse.source_density),
+            "sparse: {sparse:?}"
+        );
+        assert_eq!(sparse.density_warning(), None);
+        // 0.05 particles per pixel of σ 2.5 px: N_s ≈ 3.9, images everywhere.
+        let saturated = measure_particle_images(&random_spots(1280, 2.5, 160)).unwrap();
+        assert!(
+            saturated.source_density >= DENSE_SOURCE_DENSITY,
+            "saturated: {saturated:?}"
+        );
+        let warning = saturated.density_warning().unwrap();
+        assert!(warning.contains("source density"), "{warning}");
     }
 
     #[test]

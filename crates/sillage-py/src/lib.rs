@@ -169,6 +169,8 @@ fn set_measured(
         measured.set_item("particle_sigma_px", images.sigma_px)?;
         measured.set_item("scale_px", calibration.scale_px)?;
         measured.set_item("polarity", calibration.polarity.name())?;
+        measured.set_item("source_density", images.source_density)?;
+        measured.set_item("density_warning", images.density_warning())?;
     }
     if let Some(displacement) = displacement_px {
         measured.set_item("displacement_px", displacement)?;

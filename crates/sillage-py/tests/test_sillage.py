@@ -80,11 +80,25 @@ def test_measured_particle_images_and_displacements_are_in_attrs(vortex):
     # The vortex fixture draws particle images of σ = 2 px.
     assert 1.7 < features.attrs["particle_sigma_px"] < 2.5
     assert 0.5 < features.attrs["scale_px"] <= features.attrs["particle_sigma_px"]
+    assert 0 < features.attrs["source_density"] < 0.5
+    assert "density_warning" not in features.attrs
     tracks = sillage.ptv(frames)
     assert tracks.attrs["particle_sigma_px"] == features.attrs["particle_sigma_px"]
     assert tracks.attrs["displacement_px"] > 0
     # A given size is used as given: nothing measured.
     assert "particle_sigma_px" not in sillage.batch(frames, scale_px=2.0, polarity="bright").attrs
+
+
+def test_particle_images_too_dense_for_ptv_raise_a_warning():
+    rng = np.random.default_rng(3)
+    rows, columns = np.mgrid[0:160, 0:160]
+    frame = 0.02 * rng.random((160, 160))
+    # 0.05 particles per pixel of σ 2.5 px: their images cover the frame.
+    for x, y in rng.random((1280, 2)) * 160:
+        frame += 0.5 * np.exp(-((columns - x) ** 2 + (rows - y) ** 2) / (2 * 2.5**2))
+    with pytest.warns(UserWarning, match="source density"):
+        features = sillage.batch(frame[None].astype(np.float32))
+    assert features.attrs["source_density"] >= 0.5
 
 
 def test_ptv_passes_through_trackpy(vortex):

@@ -185,6 +185,11 @@ impl CaseData {
         let m = measure_particle_images(&self.frames[0].image)?;
         Ok((m.sigma_px, m.polarity))
     }
+
+    /// The source density measured on the first frame (`ParticleImages::source_density`).
+    pub fn measured_source_density(&self) -> Result<f64> {
+        Ok(measure_particle_images(&self.frames[0].image)?.source_density)
+    }
 }
 
 /// One setting of the grid search: the main keys.
@@ -286,6 +291,8 @@ pub struct FamilyRow {
     pub particles: usize,
     /// The particle σ measured on the first frame, px.
     pub measured_sigma_px: Option<f64>,
+    /// The source density measured on the first frame.
+    pub measured_source_density: Option<f64>,
     /// The defaults (scale and polarity measured).
     pub defaults: Recoveries,
     /// The defaults of before this family existed: `scale_px = 2`, bright.
@@ -327,6 +334,7 @@ pub fn run_case(
     Ok(FamilyRow {
         particles: case.params(size, frames).n_particles,
         measured_sigma_px: data.measured_sigma().ok().map(|(s, _)| s),
+        measured_source_density: data.measured_source_density().ok(),
         case: case.clone(),
         defaults,
         old_defaults,

@@ -72,6 +72,10 @@ pub fn track_header(
                 "detector.measured.polarity".to_string(),
                 calibration.polarity.name().to_string(),
             ),
+            (
+                "detector.measured.source_density".to_string(),
+                format!("{:.3}", measured.source_density),
+            ),
         ]);
     }
     Ok(TrackFileHeader {
