@@ -220,13 +220,21 @@ def test_ptv_iter_streams_what_ptv_returns(vortex, tmp_path):
     frames, _ = vortex
     whole = sillage.ptv(frames, motion_av=5)
     steps = list(sillage.ptv_iter(iter(frames), motion_av=5))
-    # Velocities fitted over 7 frames: frame 1 leaves at frame 4, the last ones at the end.
+    # The default warm-up (10 frames, more than these 8) holds every point to the end.
     assert len(steps) == len(frames) + 1
-    assert all(len(s) == 0 for s in steps[:4]) and set(steps[4].frame) == {1}
+    assert all(len(s) == 0 for s in steps[:-1])
     streamed = pd.concat(steps, ignore_index=True)
     pd.testing.assert_frame_equal(streamed, whole, check_dtype=False)
+    # Without it, velocities fitted over 7 frames: frame 1 leaves at frame 4, the last ones
+    # at the end.
+    cold = {"motion_av": 5, "warm_up_frames": 0}
+    steps = list(sillage.ptv_iter(iter(frames), **cold))
+    assert len(steps) == len(frames) + 1
+    assert all(len(s) == 0 for s in steps[:4]) and set(steps[4].frame) == {1}
+    pd.testing.assert_frame_equal(pd.concat(steps, ignore_index=True),
+                                  sillage.ptv(frames, **cold), check_dtype=False)
     # With TracTrac's three-frame velocities, frame t-1 leaves as soon as frame t is seen.
-    steps = list(sillage.ptv_iter(iter(frames), motion_av=5, velocity_window=3))
+    steps = list(sillage.ptv_iter(iter(frames), velocity_window=3, **cold))
     assert len(steps) == len(frames)
     assert len(steps[0]) == 0 and set(steps[2].frame) == {1}
     with pytest.raises(ValueError, match="training_passes"):

@@ -709,3 +709,52 @@ fn tracking_resumes_where_a_band_of_the_flow_suddenly_changes() {
         "{tracked} particles tracked in the last frame"
     );
 }
+
+/// Tracks `scene` with a fresh tracker as a run does (no `start_pass`, so the warm-up runs).
+fn track_fresh(scene: &Scene, params: PtvParams) -> Vec<TrackPoint> {
+    let mut tracker = PtvTracker::new(params).unwrap();
+    let mut out = Vec::new();
+    for (f, detections) in scene.frames.iter().enumerate() {
+        let obs = FrameObservations::from_detections(f as u64, detections);
+        tracker.step(&obs, &mut out).unwrap();
+    }
+    tracker.finish(&mut out).unwrap();
+    out
+}
+
+#[test]
+fn a_warm_up_links_the_first_frames_with_the_flow_it_learned() {
+    // The rotation of `motion_model_tracks_a_fast_rotation_far_better` (p⁻¹ ≈ 0.6–0.9), 12
+    // frames, no voting: from rest the first links fail and the model needs frames to learn.
+    let scene = rotating(2, 3000, (0.03, 0.0), 12, 1.0, 0);
+    let params = |warm_up_frames| PtvParams {
+        vote_search_px: VoteSearch::OFF,
+        warm_up_frames,
+        ..Default::default()
+    };
+    let (cold, cold_precision) = scene.link_scores(&track_fresh(&scene, params(0)));
+    let warm_points = track_fresh(&scene, params(10));
+    let (warm, precision) = scene.link_scores(&warm_points);
+    eprintln!(
+        "recall (precision): from rest {cold:.3} ({cold_precision:.3}), after a 10-frame \
+         warm-up {warm:.3} ({precision:.3})"
+    );
+    assert!(warm > cold + 0.15, "{warm} vs {cold}");
+    assert!(
+        precision > cold_precision,
+        "{precision} vs {cold_precision}"
+    );
+    let mut sorted = warm_points.clone();
+    sorted.sort_by_key(|p| (p.frame, p.track_id));
+    assert_eq!(sorted, warm_points, "frame by frame, in track id order");
+    // A sequence shorter than the warm-up is tracked again at its end: the same points as a
+    // warm-up over exactly its frames.
+    assert_eq!(
+        track_fresh(&scene, params(50)),
+        track_fresh(&scene, params(12))
+    );
+    // Training passes replace it: `start_pass` drops a warm-up under way.
+    let mut tracker = PtvTracker::new(params(10)).unwrap();
+    let trained = scene.feed(&mut tracker, PassDirection::Forward);
+    assert_eq!(trained, scene.track(params(0)));
+}

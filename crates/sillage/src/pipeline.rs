@@ -356,14 +356,27 @@ impl Pipeline {
     ) -> Result<RunSummary> {
         if self.training_passes == 0 {
             let mut tally = RunTally::default();
-            let timings = overlap::run(
+            let run = overlap::run(
                 &mut self.stage,
                 &mut self.tracker,
                 inputs,
                 &mut *sink,
                 &mut tally,
                 on_frame,
-            )?;
+            );
+            let timings = match run {
+                Ok(timings) => timings,
+                Err(error) => {
+                    // The points the tracker still holds (a warm-up's, those waiting for
+                    // their velocity windows) are of frames before the error: they are
+                    // written too, so that nothing tracked is lost. The error is the run's.
+                    let _ = self.tracker.as_tracker().finish(&mut CountingSink {
+                        inner: &mut *sink,
+                        tally: &mut tally,
+                    });
+                    return Err(error);
+                }
+            };
             return self.finish_run(sink, tally, timings);
         }
         let mut tally = RunTally::default();
