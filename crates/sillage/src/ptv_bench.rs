@@ -8,13 +8,16 @@ use serde::Serialize;
 use sillage_core::{DiscardSink, Result};
 use sillage_io::Frame;
 use sillage_synth::vortex::{VortexParams, VortexSequence};
+use sillage_track::ptv::DEFAULT_WARM_UP_FRAMES;
 
 use crate::config::PipelineConfig;
 use crate::pipeline::{FrameInput, Pipeline};
 use crate::process_memory::{peak_rss_mib, rss_mib};
 
-/// Frames run before timing starts (the tracker needs two frames before it links).
-const WARM_UP_FRAMES: usize = 3;
+/// Frames run before timing starts: the tracker's warm-up (its first frames tracked twice,
+/// [`DEFAULT_WARM_UP_FRAMES`], a cost paid once per run) and three more, so that the timed
+/// frames are the steady state of a long run.
+const WARM_UP_FRAMES: usize = DEFAULT_WARM_UP_FRAMES + 3;
 
 /// One row of the table.
 #[derive(Debug, Clone, Serialize)]
