@@ -204,7 +204,27 @@ impl Particles {
 
     /// Adds `log_likelihood(particle)` to each log weight (left unnormalised): the weighting of
     /// Eq. (6). NaN counts as −∞, +∞ as the largest finite value.
-    pub(crate) fn add_log_likelihood(&mut self, mut log_likelihood: impl FnMut(Particle) -> f64) {
+    pub(crate) fn add_log_likelihood(&mut self, log_likelihood: impl FnMut(Particle) -> f64) {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports AVX-512F, checked just above.
+            unsafe { self.add_log_likelihood_avx512(log_likelihood) };
+            return;
+        }
+        self.add_log_likelihood_with(log_likelihood);
+    }
+
+    /// [`Particles::add_log_likelihood`] compiled for AVX-512, so that a likelihood the
+    /// compiler can see through runs eight particles at a time (same values).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    fn add_log_likelihood_avx512(&mut self, log_likelihood: impl FnMut(Particle) -> f64) {
+        self.add_log_likelihood_with(log_likelihood);
+    }
+
+    /// The body of [`Particles::add_log_likelihood`].
+    #[inline(always)]
+    fn add_log_likelihood_with(&mut self, mut log_likelihood: impl FnMut(Particle) -> f64) {
         self.uniform = false;
         for (i, lw) in self.log_weights.iter_mut().enumerate() {
             let particle = Particle {
@@ -249,10 +269,15 @@ impl Particles {
             gather_widest(column, ancestors, scratch);
             std::mem::swap(column, scratch);
         }
-        self.scratch_mode.clear();
-        self.scratch_mode
-            .extend(ancestors.iter().map(|&a| self.mode[a as usize]));
-        std::mem::swap(&mut self.mode, &mut self.scratch_mode);
+        // One motion state throughout (a single-model filter) stays as it is.
+        if let Some((&first, rest)) = self.mode.split_first()
+            && rest.iter().any(|&m| m != first)
+        {
+            self.scratch_mode.clear();
+            self.scratch_mode
+                .extend(ancestors.iter().map(|&a| self.mode[a as usize]));
+            std::mem::swap(&mut self.mode, &mut self.scratch_mode);
+        }
         self.set_uniform_weights();
     }
 
@@ -344,7 +369,92 @@ fn gather(column: &[f64], ancestors: &[u32], out: &mut [f64]) {
     }
 }
 
-sillage_core::multiversion! {
-    /// [`gather`] on the widest SIMD the CPU offers.
-    fn gather_widest(column: &[f64], ancestors: &[u32], out: &mut [f64]) => gather
+/// [`gather`] on the fastest path the CPU offers (the same values on every path).
+fn gather_widest(column: &[f64], ancestors: &[u32], out: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx512f") {
+        // SAFETY: the CPU supports AVX-512F, checked just above.
+        unsafe { gather_sorted_avx512(column, ancestors, out) };
+        return;
+    }
+    gather(column, ancestors, out);
+}
+
+/// [`gather`] for ancestors that mostly come sorted, as resampling draws them: eight
+/// ancestors within sixteen consecutive particles (nearly always, as copies of one particle
+/// follow each other) are served by two vector loads and one permutation instead of a
+/// gather of eight scattered loads; other blocks fall back to [`gather`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn gather_sorted_avx512(column: &[f64], ancestors: &[u32], out: &mut [f64]) {
+    use std::arch::x86_64::{
+        _mm256_loadu_si256, _mm512_cmplt_epu64_mask, _mm512_cvtepu32_epi64, _mm512_loadu_pd,
+        _mm512_permutex2var_pd, _mm512_set1_epi64, _mm512_storeu_pd, _mm512_sub_epi64,
+    };
+    const LANES: usize = 8;
+    let n = ancestors.len().min(out.len());
+    let Some(last_base) = column.len().checked_sub(2 * LANES) else {
+        gather(column, ancestors, out);
+        return;
+    };
+    let blocks = n / LANES;
+    for b in 0..blocks {
+        let (a, o) = (
+            &ancestors[b * LANES..(b + 1) * LANES],
+            &mut out[b * LANES..(b + 1) * LANES],
+        );
+        let base = (a[0] as usize).min(last_base);
+        // SAFETY: the loads read 8 u32 from `a` (8 long) and 16 f64 from `column` at
+        // `base ≤ len − 16`; the store writes 8 f64 to `o` (8 long).
+        let served = unsafe {
+            let offsets = _mm512_sub_epi64(
+                _mm512_cvtepu32_epi64(_mm256_loadu_si256(a.as_ptr().cast())),
+                _mm512_set1_epi64(base as i64),
+            );
+            // Every ancestor in base..base + 16 (an ancestor below base wraps around).
+            let within = _mm512_cmplt_epu64_mask(offsets, _mm512_set1_epi64(2 * LANES as i64));
+            if within == u8::MAX {
+                let low = _mm512_loadu_pd(column.as_ptr().add(base));
+                let high = _mm512_loadu_pd(column.as_ptr().add(base + LANES));
+                _mm512_storeu_pd(o.as_mut_ptr(), _mm512_permutex2var_pd(low, offsets, high));
+                true
+            } else {
+                false
+            }
+        };
+        if !served {
+            gather(column, a, o);
+        }
+    }
+    let rest = blocks * LANES..n;
+    gather(column, &ancestors[rest.clone()], &mut out[rest]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::RngExt;
+    use sillage_core::rng_stream;
+
+    /// The vector paths give the values of the plain loop, for sorted ancestors (the
+    /// permutation), scattered ones (the fallback), columns shorter than two vectors and
+    /// lengths that leave a remainder.
+    #[test]
+    fn every_gather_path_gives_the_plain_values() {
+        let mut rng = rng_stream(8, 9);
+        for n in [1, 7, 15, 16, 17, 40, 500, 503] {
+            let column: Vec<f64> = (0..n).map(|i| i as f64 * 1.5 - 3.0).collect();
+            for sorted in [true, false] {
+                let mut ancestors: Vec<u32> =
+                    (0..n).map(|_| rng.random_range(0..n as u32)).collect();
+                if sorted {
+                    ancestors.sort_unstable();
+                }
+                let mut fast = vec![0.0; n];
+                gather_widest(&column, &ancestors, &mut fast);
+                let plain: Vec<f64> = ancestors.iter().map(|&a| column[a as usize]).collect();
+                assert_eq!(fast, plain, "n = {n}, sorted = {sorted}");
+            }
+        }
+    }
 }

@@ -198,21 +198,37 @@ sillage_core::multiversion! {
 
 /// Independent merges [`merge`] runs side by side, each over a quarter of the positions.
 const MERGE_LANES: usize = 4;
+/// Running sums a merge step compares with its position at once (one AVX-512 vector).
+const WINDOW: usize = 8;
 
 /// Appends, for each of the non-decreasing `positions` in `[0, Σw)`, the index whose
-/// cumulative-weight interval holds it. Zero-weight particles are never chosen, even when
-/// rounding pushes a position past the last cumulative sum.
+/// cumulative-weight interval holds it: the number of running sums at or below the position.
+/// Zero-weight particles are never chosen, even when rounding pushes a position past the last
+/// cumulative sum.
 ///
-/// Branch-free: each step either emits an ancestor or moves to the next weight, chosen by a
-/// comparison turned into an increment. On the peaked weights a likelihood leaves, the usual
-/// nested loop mispredicts about once per particle; this form measured ~20 % faster. A merge
-/// is one chain of dependent loads, so the positions are cut into [`MERGE_LANES`] runs, each
-/// started by a binary search, and the runs step in turn: the processor overlaps them. The
-/// last positive weight's running sum is replaced by +∞, so that no step needs to check the
-/// end of the weights, and the runs step together for as many steps as the shortest has
-/// positions left, so that no step checks the end of the positions either: what is left of
-/// the state then fits in registers.
+/// Each step compares one position with the next [`WINDOW`] running sums at once: they are
+/// sorted, so the sums at or below it are a prefix of the window, and its length is the
+/// number of trailing ones of the comparison mask. A prefix shorter than the window gives the
+/// ancestor and moves to the next position; a full one moves on by a window. Steps are
+/// branch-free, and there are about as many as positions (a merge stepping one running sum at
+/// a time takes twice as many, each one a dependent load). A merge is still one chain of
+/// dependent steps, so the positions are cut into [`MERGE_LANES`] runs, each started by a
+/// binary search, and the runs step in turn: the processor overlaps them. The last positive
+/// weight's running sum and the window's padding after it are +∞, so that no step needs to
+/// check the end of the weights, and the runs step together for as many steps as the shortest
+/// has positions left, so that no step checks the end of the positions either.
 fn merge(weights: &[f64], positions: &[f64], cumulative: &mut Vec<f64>, out: &mut Vec<u32>) {
+    merge_with(weights, positions, cumulative, out, merge_runs_widest);
+}
+
+/// [`merge`] with the runs stepped by `runs`.
+fn merge_with(
+    weights: &[f64],
+    positions: &[f64],
+    cumulative: &mut Vec<f64>,
+    out: &mut Vec<u32>,
+    runs: fn(&[f64], &[f64], &mut [u32], MergeState),
+) {
     let Some(last_positive) = weights.iter().rposition(|&w| w > 0.0) else {
         return;
     };
@@ -223,24 +239,54 @@ fn merge(weights: &[f64], positions: &[f64], cumulative: &mut Vec<f64>, out: &mu
     let start = out.len();
     out.resize(start + m, 0);
     let out = &mut out[start..];
-    let mut k: [usize; MERGE_LANES] = std::array::from_fn(|lane| lane * m / MERGE_LANES);
+    let k: [usize; MERGE_LANES] = std::array::from_fn(|lane| lane * m / MERGE_LANES);
     let end: [usize; MERGE_LANES] = std::array::from_fn(|lane| (lane + 1) * m / MERGE_LANES);
     // Where a merge from the first weight would stand at each run's first position.
-    let mut j = k.map(|first| match positions.get(first) {
+    let j = k.map(|first| match positions.get(first) {
         Some(&p) => cumulative[..last_positive].partition_point(|&c| c <= p),
         None => 0,
     });
     cumulative[last_positive] = f64::INFINITY;
-    let cumulative = &cumulative[..];
+    cumulative.resize(last_positive + WINDOW, f64::INFINITY);
+    runs(cumulative, positions, out, (j, k, end));
+}
+
+/// Bit `t` set when `window[t] ≤ p`.
+type AtOrBelow = fn(&[f64; WINDOW], f64) -> u32;
+
+/// [`AtOrBelow`] element by element.
+#[inline(always)]
+fn at_or_below(window: &[f64; WINDOW], p: f64) -> u32 {
+    let mut below = 0;
+    for (t, &c) in window.iter().enumerate() {
+        below |= u32::from(c <= p) << t;
+    }
+    below
+}
+
+/// The runs of [`merge`], from running sums at `j` and positions at `k` to `end` (per run);
+/// `cumulative` ends in at least [`WINDOW`] values of +∞. `mask` compares a window.
+#[inline(always)]
+fn merge_runs(
+    cumulative: &[f64],
+    positions: &[f64],
+    out: &mut [u32],
+    (mut j, mut k, end): MergeState,
+    mask: AtOrBelow,
+) {
     let step = |lane: usize,
                 j: &mut [usize; MERGE_LANES],
                 k: &mut [usize; MERGE_LANES],
                 out: &mut [u32]| {
         let (jl, kl) = (j[lane], k[lane]);
-        let advance = cumulative[jl] <= positions[kl];
-        out[kl] = jl as u32;
-        j[lane] = jl + usize::from(advance);
-        k[lane] = kl + usize::from(!advance);
+        let window: &[f64; WINDOW] = cumulative[jl..jl + WINDOW]
+            .try_into()
+            .expect("the running sums end in a window of +∞");
+        // The length of the prefix at or below the position, at most WINDOW.
+        let taken = (!mask(window, positions[kl]) | (1 << WINDOW)).trailing_zeros() as usize;
+        out[kl] = (jl + taken) as u32;
+        j[lane] = jl + taken;
+        k[lane] = kl + usize::from(taken < WINDOW);
     };
     loop {
         let steps = (0..MERGE_LANES).map(|lane| end[lane] - k[lane]).min();
@@ -259,6 +305,41 @@ fn merge(weights: &[f64], positions: &[f64], cumulative: &mut Vec<f64>, out: &mu
             step(lane, &mut j, &mut k, out);
         }
     }
+}
+
+/// Each run's running-sum index, position index and end.
+type MergeState = (
+    [usize; MERGE_LANES],
+    [usize; MERGE_LANES],
+    [usize; MERGE_LANES],
+);
+
+/// [`merge_runs`] with one vector comparison per window where the CPU has AVX-512 (the same
+/// ancestors on every path).
+fn merge_runs_widest(cumulative: &[f64], positions: &[f64], out: &mut [u32], state: MergeState) {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx512f") {
+        // SAFETY: the CPU supports AVX-512F, checked just above.
+        unsafe { merge_runs_avx512(cumulative, positions, out, state) };
+        return;
+    }
+    merge_runs(cumulative, positions, out, state, at_or_below);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn merge_runs_avx512(cumulative: &[f64], positions: &[f64], out: &mut [u32], state: MergeState) {
+    use std::arch::x86_64::{_CMP_LE_OQ, _mm512_cmp_pd_mask, _mm512_loadu_pd, _mm512_set1_pd};
+    #[inline(always)]
+    fn vector_at_or_below(window: &[f64; WINDOW], p: f64) -> u32 {
+        // SAFETY: AVX-512F is enabled in the only caller, and the eight doubles are read
+        // from a borrowed array of eight.
+        unsafe {
+            let sums = _mm512_loadu_pd(window.as_ptr());
+            u32::from(_mm512_cmp_pd_mask::<_CMP_LE_OQ>(sums, _mm512_set1_pd(p)))
+        }
+    }
+    merge_runs(cumulative, positions, out, state, vector_at_or_below);
 }
 
 #[cfg(test)]
@@ -331,6 +412,16 @@ mod tests {
             positions.sort_by(f64::total_cmp);
             let mut out = vec![7];
             merge(&weights, &positions, &mut cumulative, &mut out);
+            // The element-by-element comparison gives the same ancestors as the vector one.
+            let mut portable = vec![7];
+            merge_with(
+                &weights,
+                &positions,
+                &mut cumulative,
+                &mut portable,
+                |c, p, o, s| merge_runs(c, p, o, s, at_or_below),
+            );
+            assert_eq!(portable, out);
             if total > 0.0 {
                 assert_eq!(out[0], 7);
                 assert_eq!(out[1..], ancestors_by_search(&weights, &positions)[..]);

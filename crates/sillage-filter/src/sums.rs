@@ -6,8 +6,20 @@
 /// Independent chains per reduction.
 const CHAINS: usize = 8;
 
-/// `Σ values`, summed in [`CHAINS`] lanes combined pairwise.
-pub(crate) fn lane_sum(values: &[f64]) -> f64 {
+sillage_core::multiversion! {
+    /// `Σ values`, summed in [`CHAINS`] lanes combined pairwise.
+    pub(crate) fn lane_sum(values: &[f64]) -> f64 => sum_in_lanes
+}
+
+sillage_core::multiversion! {
+    /// The largest value, NaN ignored (−∞ for none), as `f64::max` folds it, in [`CHAINS`]
+    /// lanes.
+    pub(crate) fn lane_max(values: &[f64]) -> f64 => max_in_lanes
+}
+
+/// The body of [`lane_sum`].
+#[inline(always)]
+fn sum_in_lanes(values: &[f64]) -> f64 {
     let mut sums = [0.0; CHAINS];
     let mut chunks = values.chunks_exact(CHAINS);
     for chunk in &mut chunks {
@@ -21,8 +33,9 @@ pub(crate) fn lane_sum(values: &[f64]) -> f64 {
     pairwise(sums, |a, b| a + b)
 }
 
-/// The largest value, NaN ignored (−∞ for none), as `f64::max` folds it, in [`CHAINS`] lanes.
-pub(crate) fn lane_max(values: &[f64]) -> f64 {
+/// The body of [`lane_max`].
+#[inline(always)]
+fn max_in_lanes(values: &[f64]) -> f64 {
     let mut maxima = [f64::NEG_INFINITY; CHAINS];
     let mut chunks = values.chunks_exact(CHAINS);
     for chunk in &mut chunks {

@@ -67,6 +67,20 @@ sillage_core::multiversion! {
     fn exponentials_widest(log_weights: &[f64], linear: &mut [f64], max: f64) -> (f64, f64) => exponentials
 }
 
+/// `log_weights[i] −= log_norm` and `linear[i] ·= inv`: the normalisation's last pass.
+#[inline(always)]
+fn rescale(log_weights: &mut [f64], linear: &mut [f64], log_norm: f64, inv: f64) {
+    for (lw, w) in log_weights.iter_mut().zip(linear.iter_mut()) {
+        *lw -= log_norm;
+        *w *= inv;
+    }
+}
+
+sillage_core::multiversion! {
+    /// [`rescale`] on the widest SIMD the CPU offers.
+    fn rescale_widest(log_weights: &mut [f64], linear: &mut [f64], log_norm: f64, inv: f64) => rescale
+}
+
 /// Normalises `log_weights` in place so that `Σᵢ exp(log_weightsᵢ) = 1`, and writes the linear
 /// normalised weights to `linear` (same length). When every weight is zero the set is reset to
 /// uniform and `recovered` says so: the caller counts that event.
@@ -89,11 +103,7 @@ pub fn normalise(log_weights: &mut [f64], linear: &mut [f64]) -> Normalisation {
     // cannot underflow either.
     let (sum, sum_sq) = exponentials_widest(log_weights, linear, max);
     let log_norm = max + sum.ln();
-    let inv = 1.0 / sum;
-    for (lw, w) in log_weights.iter_mut().zip(linear.iter_mut()) {
-        *lw -= log_norm;
-        *w *= inv;
-    }
+    rescale_widest(log_weights, linear, log_norm, 1.0 / sum);
     Normalisation {
         log_evidence: log_norm,
         ess: sum * sum / sum_sq,
