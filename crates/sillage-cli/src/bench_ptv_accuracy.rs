@@ -47,7 +47,7 @@ pub struct BenchPtvAccuracyArgs {
     /// Skip the grid search (defaults and old defaults only; much faster).
     #[arg(long)]
     pub no_search: bool,
-    /// Score the defaults with this key set, e.g. `--set detector.deblend=true` (repeatable).
+    /// Score the defaults with this key set, e.g. `--set detector.deblend=false` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// `--json`: a machine-readable table on stdout.

@@ -30,14 +30,16 @@ fn call(server: &TuneServer, method: &str, path: &str, body: Option<&Value>) -> 
     (status, reply)
 }
 
-/// Detections of frame `index` of `frames` by the library, with the default configuration.
-fn library_count(frames: &str, index: usize) -> usize {
+/// Detections of frame `index` of `frames` by the library, with `config` (as the page sends
+/// it).
+fn library_count(frames: &str, index: usize, config: &Value) -> usize {
+    let config: PipelineConfig = serde_json::from_value(config.clone()).unwrap();
     let frame = open_frames(frames, &FrameOptions::default())
         .unwrap()
         .nth(index)
         .unwrap()
         .unwrap();
-    let mut stage = DetectionStage::from_config(&PipelineConfig::default()).unwrap();
+    let mut stage = DetectionStage::from_config(&config).unwrap();
     let mut detections = Vec::new();
     stage.detect(&frame, &mut detections).unwrap();
     detections.len()
@@ -75,7 +77,7 @@ fn api_detects_as_the_library_and_saves_a_config_ptv_reads() {
     );
     assert_eq!(status, 200, "{reply}");
     let count = reply["count"].as_u64().unwrap() as usize;
-    assert_eq!(count, library_count(&frames, 1));
+    assert_eq!(count, library_count(&frames, 1, &config));
     assert!(
         (30..=45).contains(&count),
         "{count} detections of 40 particles"

@@ -239,8 +239,12 @@ pub struct BlobParams {
     pub roi: Option<Roi>,
     /// Split the detections that are two overlapping particles by a two-particle fit, with the
     /// automatic scale where the matched-scale second look runs (docs/ptv.md, "Overlapping
-    /// particles split"). Default false: in frames crowded with particles of σ ≳ 1.5 px it
-    /// costs many times the rest of the detection.
+    /// particles split"). Default true since 2026-11-30: on the report halves of both
+    /// accuracy families (never used to choose it or its constants) it lifts the mean true
+    /// recoveries from 85.1 to 89.9 % (moderate, false 3.3 → 2.0 %) and from 48.7 to 50.9 %
+    /// (main), with no trackable case losing. Its cost: in frames crowded with particles of
+    /// σ ≈ 2 px (25,000 on 2048²) detection takes about four times as long; `false` for runs
+    /// where time matters more than accuracy.
     pub deblend: bool,
 }
 
@@ -254,7 +258,7 @@ impl Default for BlobParams {
             polarity: PolarityChoice::Auto,
             subpixel: SubpixelFit::Gaussian,
             roi: None,
-            deblend: false,
+            deblend: true,
         }
     }
 }
