@@ -1,8 +1,8 @@
 //! Blob detection on a 2048² frame with ~25,000 Gaussian spots (σ = 1.2 px) and noise, seeded:
 //! the defaults (scale and polarity measured on the first call, then the matched-scale second
 //! look), a given scale (no second look), and the measurement itself (once per run). Then
-//! the same seeding at σ = 2 px, where particle images overlap, without and with
-//! `detector.deblend`.
+//! the same seeding at σ = 2 px, where particle images overlap, with the defaults (which
+//! split overlapping particles, `detector.deblend`) and without the split.
 //! Run with `cargo bench -p sillage-detect --bench blob`.
 
 #[path = "../tests/common/mod.rs"]
@@ -75,7 +75,7 @@ fn bench_deblend(c: &mut Criterion) {
         .unwrap();
         let mut out = Vec::new();
         detector.detect(&frame, &mut out).unwrap();
-        let name = if deblend { "deblend" } else { "defaults" };
+        let name = if deblend { "defaults" } else { "no_deblend" };
         group.bench_function(name, |b| {
             b.iter(|| detector.detect(black_box(&frame), &mut out).unwrap())
         });
