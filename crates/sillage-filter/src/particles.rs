@@ -377,7 +377,12 @@ fn gather_widest(column: &[f64], ancestors: &[u32], out: &mut [f64]) {
         unsafe { gather_sorted_avx512(column, ancestors, out) };
         return;
     }
-    gather(column, ancestors, out);
+    gather_vectorised(column, ancestors, out);
+}
+
+sillage_core::multiversion! {
+    /// [`gather`] compiled for AVX2 where the CPU has it (vector gathers), else the baseline.
+    fn gather_vectorised(column: &[f64], ancestors: &[u32], out: &mut [f64]) => gather
 }
 
 /// [`gather`] for ancestors that mostly come sorted, as resampling draws them: eight
