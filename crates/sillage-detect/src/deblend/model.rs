@@ -29,6 +29,8 @@ const MAX_ITERATIONS: usize = 12;
 pub(super) type Amplitudes = [f64; 1 + MAX_COMPONENTS];
 type Params = [f64; MAX_PARAMETERS];
 type Normal = [f64; MAX_PARAMETERS * MAX_PARAMETERS];
+/// The inner products of the profiles along one axis.
+type Gram = [[f64; MAX_PROFILES]; MAX_PROFILES];
 
 /// The index of component `c`'s profile: its Gaussian times the offset from its centre to
 /// the power `power` (0–2). Profile 0 is the constant 1.
@@ -69,9 +71,9 @@ pub(super) struct Profiles {
     /// Per row profile, per column: the column's values times the profile, summed.
     projected: Vec<f64>,
     /// Inner products of the column profiles.
-    col_gram: [[f64; MAX_PROFILES]; MAX_PROFILES],
+    col_gram: Gram,
     /// Inner products of the row profiles.
-    row_gram: [[f64; MAX_PROFILES]; MAX_PROFILES],
+    row_gram: Gram,
 }
 
 impl Profiles {
@@ -93,26 +95,22 @@ impl Profiles {
     /// Projects the window's values on the row profiles `which` and takes the inner
     /// products among them and among the column profiles of the same indices.
     fn prepare(&mut self, window: &Window<'_>, which: &[usize]) {
+        self.prepare_more(window, &[], which);
+    }
+
+    /// [`Profiles::prepare`] for the profiles `new` when those of `done` are prepared
+    /// already (same profiles): projects `new` and takes the inner products of `new` with
+    /// `done` and among themselves.
+    fn prepare_more(&mut self, window: &Window<'_>, done: &[usize], new: &[usize]) {
         let side = self.side;
         self.projected.resize(self.rows.len(), 0.0);
-        for &q in which {
-            self.projected[q * side..][..side].fill(0.0);
-        }
-        // Row by row, so that each update runs along contiguous values.
-        for (j, values) in window.values.chunks_exact(side).enumerate() {
-            for &q in which {
-                let weight = self.rows[q * side + j];
-                for (sum, &z) in self.projected[q * side..][..side].iter_mut().zip(values) {
-                    *sum += weight * z;
-                }
-            }
-        }
-        for (a, &p) in which.iter().enumerate() {
-            for &q in &which[a..] {
-                let (c, r) = (dot(self.col(p), self.col(q)), dot(self.row(p), self.row(q)));
-                (self.col_gram[p][q], self.col_gram[q][p]) = (c, c);
-                (self.row_gram[p][q], self.row_gram[q][p]) = (r, r);
-            }
+        project_widest(window.values, side, &self.rows, new, &mut self.projected);
+        let axes = [
+            (&self.cols, &mut self.col_gram),
+            (&self.rows, &mut self.row_gram),
+        ];
+        for (profiles, gram) in axes {
+            inner_products_widest(profiles, side, done, new, gram);
         }
     }
 
@@ -143,6 +141,110 @@ impl Profiles {
     }
 }
 
+/// Per row profile `q` of `which` and per column `i` of the window (`values`, `side`²):
+/// `projected[q][i] = Σ_j rows[q][j] · values[j][i]`, summed in the order of `j` from zero.
+/// Row by row, so that each update runs along contiguous values.
+fn project(values: &[f64], side: usize, rows: &[f64], which: &[usize], projected: &mut [f64]) {
+    for &q in which {
+        projected[q * side..][..side].fill(0.0);
+    }
+    for (j, values) in values.chunks_exact(side).enumerate() {
+        for &q in which {
+            let weight = rows[q * side + j];
+            for (sum, &z) in projected[q * side..][..side].iter_mut().zip(values) {
+                *sum += weight * z;
+            }
+        }
+    }
+}
+
+/// [`project`], on AVX-512 where the CPU has it (the same bits: each sum in the same order,
+/// multiply and add not fused).
+fn project_widest(
+    values: &[f64],
+    side: usize,
+    rows: &[f64],
+    which: &[usize],
+    projected: &mut [f64],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx512f") {
+        // SAFETY: the CPU supports AVX-512F, checked just above.
+        unsafe { project_avx512(values, side, rows, which, projected) };
+        return;
+    }
+    project(values, side, rows, which, projected);
+}
+
+/// [`project`] eight columns at a time, the sums of up to six profiles held in registers
+/// across the rows.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn project_avx512(
+    values: &[f64],
+    side: usize,
+    rows: &[f64],
+    which: &[usize],
+    projected: &mut [f64],
+) {
+    assert!(values.len() >= side * side);
+    assert!(
+        which
+            .iter()
+            .all(|&q| (q + 1) * side <= rows.len().min(projected.len()))
+    );
+    for which in which.chunks(6) {
+        match which.len() {
+            1 => project_avx512_n::<1>(values, side, rows, which, projected),
+            2 => project_avx512_n::<2>(values, side, rows, which, projected),
+            3 => project_avx512_n::<3>(values, side, rows, which, projected),
+            4 => project_avx512_n::<4>(values, side, rows, which, projected),
+            5 => project_avx512_n::<5>(values, side, rows, which, projected),
+            _ => project_avx512_n::<6>(values, side, rows, which, projected),
+        }
+    }
+}
+
+/// [`project_avx512`] for `N` profiles (`which`, checked by the caller against the buffers).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn project_avx512_n<const N: usize>(
+    values: &[f64],
+    side: usize,
+    rows: &[f64],
+    which: &[usize],
+    projected: &mut [f64],
+) {
+    use std::arch::x86_64::{
+        _mm512_add_pd, _mm512_mask_storeu_pd, _mm512_maskz_loadu_pd, _mm512_mul_pd, _mm512_set1_pd,
+        _mm512_setzero_pd,
+    };
+    let which: &[usize; N] = which.try_into().expect("N profiles");
+    let mut first = 0;
+    while first < side {
+        let mask = (0xffu32 >> 8usize.saturating_sub(side - first)) as u8;
+        // SAFETY: AVX-512F is enabled in the only caller. Lane `l` of a load or store at
+        // `first` is at most `first + l < side` within its row of `side` values, the others
+        // are masked (a masked lane is neither read nor written); the caller checked that
+        // `values` holds `side` rows and that each profile `q` has `side` entries in `rows`
+        // and `projected`.
+        unsafe {
+            let mut sums = [_mm512_setzero_pd(); N];
+            for j in 0..side {
+                let z = _mm512_maskz_loadu_pd(mask, values.as_ptr().add(j * side + first));
+                for (sum, &q) in sums.iter_mut().zip(which) {
+                    let weight = _mm512_set1_pd(*rows.get_unchecked(q * side + j));
+                    *sum = _mm512_add_pd(*sum, _mm512_mul_pd(weight, z));
+                }
+            }
+            for (sum, &q) in sums.iter().zip(which) {
+                _mm512_mask_storeu_pd(projected.as_mut_ptr().add(q * side + first), mask, *sum);
+            }
+        }
+        first += 8;
+    }
+}
+
 /// Appends a component's three profiles along one axis: g, g·d, g·d² at the `side` pixels
 /// from `origin`, d the offset from `at`. The Gaussian by its recurrence, g(d + 1) = g(d) ·
 /// r(d) with r(d + 1) = r(d) · e^(−1/s²) (`inv2` = 1/2s²): three exponentials, not `side`.
@@ -163,8 +265,27 @@ fn push_axis(profiles: &mut Vec<f64>, side: usize, origin: usize, at: f64, inv2:
     }
 }
 
+/// The inner products of the profiles `new` (`side` values each in `profiles`, the layout
+/// of [`profile`]) with those of `done` and among themselves, stored both ways in `gram`.
+#[inline(always)]
+fn inner_products(profiles: &[f64], side: usize, done: &[usize], new: &[usize], gram: &mut Gram) {
+    let of = |p: usize| &profiles[p * side..][..side];
+    for (a, &p) in new.iter().enumerate() {
+        for &q in done.iter().chain(&new[a..]) {
+            let value = dot(of(p), of(q));
+            (gram[p][q], gram[q][p]) = (value, value);
+        }
+    }
+}
+
+sillage_core::multiversion! {
+    /// [`inner_products`] on the widest SIMD the CPU offers.
+    fn inner_products_widest(profiles: &[f64], side: usize, done: &[usize], new: &[usize], gram: &mut Gram) => inner_products
+}
+
 /// The inner product of two profiles, in four independent sums (so that the additions
 /// pipeline and vectorise; the order is fixed, so results are reproducible).
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let mut lanes = [0.0; 4];
     let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
@@ -287,7 +408,8 @@ impl Model<'_> {
             theta[4 + 3 * c] = centre.y;
         }
         let mut lambda = 1e-3;
-        let (mut residual, mut system) = self.evaluate_with_system(&theta, profiles);
+        self.evaluate(&theta, profiles);
+        let (mut residual, mut system) = self.system(&theta, profiles);
         for _ in 0..MAX_ITERATIONS {
             let mut damped = system.normal;
             for d in 0..n {
@@ -311,7 +433,8 @@ impl Model<'_> {
             if tried < residual {
                 let gain = residual - tried;
                 theta = trial;
-                (residual, system) = self.evaluate_with_system(&theta, profiles);
+                // `evaluate` left the profiles at the trial, now θ.
+                (residual, system) = self.system(&theta, profiles);
                 lambda = (lambda * 0.1).max(1e-9);
                 if gain < self.tolerance {
                     break;
@@ -368,27 +491,31 @@ impl Model<'_> {
         total.max(0.0)
     }
 
-    /// The squared residual at θ, with JᵀJ and Jᵀr.
-    fn evaluate_with_system(&self, theta: &Params, profiles: &mut Profiles) -> (f64, System) {
-        self.set_profiles(theta, profiles);
-        let mut which = [0; MAX_PROFILES];
-        let profile_count = 1 + 3 * self.free;
-        for (p, w) in which[..profile_count].iter_mut().enumerate() {
-            *w = p;
+    /// The squared residual at θ, with JᵀJ and Jᵀr, from `profiles` as [`Model::evaluate`]
+    /// at the same θ leaves them (the Gaussians' profiles prepared; the others are added).
+    fn system(&self, theta: &Params, profiles: &mut Profiles) -> (f64, System) {
+        let mut done = [0; 1 + MAX_FREE];
+        let mut new = [0; 2 * MAX_FREE];
+        for c in 0..self.free {
+            done[1 + c] = profile(c, 0);
+            (new[2 * c], new[2 * c + 1]) = (profile(c, 1), profile(c, 2));
         }
-        profiles.prepare(self.window, &which[..profile_count]);
+        profiles.prepare_more(self.window, &done[..1 + self.free], &new[..2 * self.free]);
         // The terms: the constant, then five per particle.
         let term_count = 1 + 5 * self.free;
-        let term = |m: usize| match m {
+        let terms: [Term; MAX_TERMS] = std::array::from_fn(|m| match m {
             0 => Term::CONSTANT,
             m => Term::of((m - 1) / 5, (m - 1) % 5),
-        };
+        });
+        let terms = &terms[..term_count];
         let mut gram = [[0.0; MAX_TERMS]; MAX_TERMS];
         let mut data = [0.0; MAX_TERMS];
-        for (m, (row, d)) in gram.iter_mut().zip(&mut data).take(term_count).enumerate() {
-            *d = profiles.data(term(m));
-            for (k, g) in row[..term_count].iter_mut().enumerate() {
-                *g = profiles.gram(term(m), term(k));
+        // The inner products are symmetric (the profiles' are stored both ways).
+        for (m, &a) in terms.iter().enumerate() {
+            data[m] = profiles.data(a);
+            for (k, &b) in terms.iter().enumerate().skip(m) {
+                let g = profiles.gram(a, b);
+                (gram[m][k], gram[k][m]) = (g, g);
             }
         }
         // The model on the terms (constant and Gaussians), its fit to the data and the
@@ -453,6 +580,18 @@ impl Model<'_> {
 /// Solves `a·x = b` for a symmetric positive definite `a` (n × n, row-major) by Cholesky, in
 /// place (`b` becomes `x`); false when `a` is not positive definite.
 fn solve_symmetric(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
+    // The sizes of the Levenberg–Marquardt fits, compiled for their constant size.
+    match n {
+        5 => cholesky(a, b, 5),
+        8 => cholesky(a, b, 8),
+        n => cholesky(a, b, n),
+    }
+}
+
+/// [`solve_symmetric`]'s body.
+#[inline(always)]
+fn cholesky(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
+    let (a, b) = (&mut a[..n * n], &mut b[..n]);
     for j in 0..n {
         let mut d = a[j * n + j];
         for k in 0..j {
@@ -568,7 +707,7 @@ mod tests {
             let (residual, normal, gradient) = direct(&window, &model, &theta);
             let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * (1.0 + a.abs().max(b.abs()));
             assert!(close(model.evaluate(&theta, &mut profiles), residual));
-            let (separable, system) = model.evaluate_with_system(&theta, &mut profiles);
+            let (separable, system) = model.system(&theta, &mut profiles);
             assert!(close(separable, residual), "{separable} vs {residual}");
             let n = model.parameters();
             for a in 0..n {
@@ -581,6 +720,34 @@ mod tests {
                     assert!(
                         close(got, want),
                         "JᵀJ[{a}][{b}] {got} vs {want}, {free} free"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_vector_projection_gives_the_bits_of_the_plain_loop() {
+        for side in [5, 8, 9, 13, 16, 17, 21] {
+            let values: Vec<f64> = (0..side * side)
+                .map(|k| (0.37 * k as f64).sin() * 1e3 + 0.1)
+                .collect();
+            let rows: Vec<f64> = (0..MAX_PROFILES * side)
+                .map(|k| (0.11 * k as f64).cos())
+                .collect();
+            for count in 1..=MAX_PROFILES {
+                let which: Vec<usize> = (0..count).map(|k| (5 * k + side) % MAX_PROFILES).collect();
+                let mut which = which;
+                which.sort_unstable();
+                which.dedup();
+                let (mut plain, mut widest) = (vec![7.0; rows.len()], vec![7.0; rows.len()]);
+                project(&values, side, &rows, &which, &mut plain);
+                project_widest(&values, side, &rows, &which, &mut widest);
+                for &q in &which {
+                    let (a, b) = (&plain[q * side..][..side], &widest[q * side..][..side]);
+                    assert!(
+                        a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                        "side {side}, profile {q}"
                     );
                 }
             }
