@@ -187,12 +187,6 @@ fn project_avx512(
     which: &[usize],
     projected: &mut [f64],
 ) {
-    assert!(values.len() >= side * side);
-    assert!(
-        which
-            .iter()
-            .all(|&q| (q + 1) * side <= rows.len().min(projected.len()))
-    );
     for which in which.chunks(6) {
         match which.len() {
             1 => project_avx512_n::<1>(values, side, rows, which, projected),
@@ -205,7 +199,7 @@ fn project_avx512(
     }
 }
 
-/// [`project_avx512`] for `N` profiles (`which`, checked by the caller against the buffers).
+/// [`project_avx512`] for `N` profiles.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn project_avx512_n<const N: usize>(
@@ -219,26 +213,27 @@ fn project_avx512_n<const N: usize>(
         _mm512_add_pd, _mm512_mask_storeu_pd, _mm512_maskz_loadu_pd, _mm512_mul_pd, _mm512_set1_pd,
         _mm512_setzero_pd,
     };
-    let which: &[usize; N] = which.try_into().expect("N profiles");
+    let values = &values[..side * side];
+    let weights: [&[f64]; N] = std::array::from_fn(|a| &rows[which[a] * side..][..side]);
     let mut first = 0;
     while first < side {
         let mask = (0xffu32 >> 8usize.saturating_sub(side - first)) as u8;
         // SAFETY: AVX-512F is enabled in the only caller. Lane `l` of a load or store at
-        // `first` is at most `first + l < side` within its row of `side` values, the others
-        // are masked (a masked lane is neither read nor written); the caller checked that
-        // `values` holds `side` rows and that each profile `q` has `side` entries in `rows`
-        // and `projected`.
+        // `first` is at most `first + l < side` within a row of `side` values (of `values`,
+        // or of a profile's `side` entries of `projected`, both sliced to length); the other
+        // lanes are masked, neither read nor written. `j < side`, each weight slice's length.
         unsafe {
             let mut sums = [_mm512_setzero_pd(); N];
             for j in 0..side {
                 let z = _mm512_maskz_loadu_pd(mask, values.as_ptr().add(j * side + first));
-                for (sum, &q) in sums.iter_mut().zip(which) {
-                    let weight = _mm512_set1_pd(*rows.get_unchecked(q * side + j));
+                for (sum, weights) in sums.iter_mut().zip(&weights) {
+                    let weight = _mm512_set1_pd(*weights.get_unchecked(j));
                     *sum = _mm512_add_pd(*sum, _mm512_mul_pd(weight, z));
                 }
             }
             for (sum, &q) in sums.iter().zip(which) {
-                _mm512_mask_storeu_pd(projected.as_mut_ptr().add(q * side + first), mask, *sum);
+                let out = &mut projected[q * side..][..side];
+                _mm512_mask_storeu_pd(out.as_mut_ptr().add(first), mask, *sum);
             }
         }
         first += 8;
