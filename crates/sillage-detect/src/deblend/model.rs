@@ -731,8 +731,8 @@ mod tests {
                 .map(|k| (0.11 * k as f64).cos())
                 .collect();
             for count in 1..=MAX_PROFILES {
-                let which: Vec<usize> = (0..count).map(|k| (5 * k + side) % MAX_PROFILES).collect();
-                let mut which = which;
+                let mut which: Vec<usize> =
+                    (0..count).map(|k| (5 * k + side) % MAX_PROFILES).collect();
                 which.sort_unstable();
                 which.dedup();
                 let (mut plain, mut widest) = (vec![7.0; rows.len()], vec![7.0; rows.len()]);
