@@ -2,7 +2,8 @@
 //! the defaults (scale and polarity measured on the first call, then the matched-scale second
 //! look), a given scale (no second look), and the measurement itself (once per run). Then
 //! the same seeding at σ = 2 px, where particle images overlap, with the defaults (which
-//! split overlapping particles, `detector.deblend`) and without the split.
+//! split overlapping particles, `detector.deblend`), without the split, and with the crowded
+//! re-fits as well (`detector.refit_crowded`).
 //! Run with `cargo bench -p sillage-detect --bench blob`.
 
 #[path = "../tests/common/mod.rs"]
@@ -67,15 +68,20 @@ fn bench_deblend(c: &mut Criterion) {
     let frame = frame(2.0);
     let mut group = c.benchmark_group("blob_2048x2048_25k_sigma2");
     group.sample_size(10);
-    for deblend in [false, true] {
+    let settings = [
+        ("no_deblend", false, false),
+        ("defaults", true, false),
+        ("refit_crowded", true, true),
+    ];
+    for (name, deblend, refit_crowded) in settings {
         let mut detector = BlobDetector::new(BlobParams {
             deblend,
+            refit_crowded,
             ..BlobParams::default()
         })
         .unwrap();
         let mut out = Vec::new();
         detector.detect(&frame, &mut out).unwrap();
-        let name = if deblend { "defaults" } else { "no_deblend" };
         group.bench_function(name, |b| {
             b.iter(|| detector.detect(black_box(&frame), &mut out).unwrap())
         });

@@ -111,8 +111,8 @@ pub(crate) struct MatchedRefiner {
 
 impl MatchedRefiner {
     /// A refiner for particle images of std `sigma_px`, which also splits unresolved pairs
-    /// with `deblend`.
-    pub(crate) fn new(sigma_px: f64, deblend: bool) -> Result<Self> {
+    /// with `deblend` and then re-fits the crowded detections with `refit_crowded`.
+    pub(crate) fn new(sigma_px: f64, deblend: bool, refit_crowded: bool) -> Result<Self> {
         let mut dog = DogFilter::new(sigma_px)?;
         let round_share = phase_spread(&mut dog, sigma_px).min(ROUND_PEAK_SHARE);
         Ok(Self {
@@ -132,7 +132,7 @@ impl MatchedRefiner {
             twins: Vec::new(),
             sharpness: Vec::new(),
             added: Vec::new(),
-            deblender: deblend.then(|| Deblender::new(sigma_px)),
+            deblender: deblend.then(|| Deblender::new(sigma_px, refit_crowded)),
         })
     }
 
@@ -511,7 +511,7 @@ mod tests {
 
     /// The re-fits of `detections` on `frame`, at σ = `SIGMA_PX`, adding no faint particles.
     fn refine_without_completion(frame: &GrayImage, detections: &mut Vec<Detection>) {
-        let mut refiner = MatchedRefiner::new(SIGMA_PX, false).unwrap();
+        let mut refiner = MatchedRefiner::new(SIGMA_PX, false, false).unwrap();
         refiner.refine(
             frame,
             Polarity::Bright,

@@ -340,3 +340,25 @@ fn background_subtraction_removes_a_static_scene() {
     assert!(image.as_slice().iter().all(|&v| v.abs() < 1e-6));
     assert!(fresh.background().is_some());
 }
+
+#[test]
+fn crowded_re_fits_without_the_splitter_are_refused_naming_both_keys() {
+    let params = BlobParams {
+        deblend: false,
+        refit_crowded: true,
+        ..BlobParams::default()
+    };
+    let Err(error) = BlobDetector::new(params) else {
+        panic!("refit_crowded without deblend was accepted");
+    };
+    let message = error.to_string();
+    assert!(
+        message.contains("refit_crowded") && message.contains("deblend = true"),
+        "{message}"
+    );
+    let with_splitter = BlobParams {
+        refit_crowded: true,
+        ..BlobParams::default()
+    };
+    assert!(BlobDetector::new(with_splitter).is_ok());
+}
