@@ -2,8 +2,8 @@
 //! the defaults (scale and polarity measured on the first call, then the matched-scale second
 //! look), a given scale (no second look), and the measurement itself (once per run). Then
 //! the same seeding at σ = 2 px, where particle images overlap, with the defaults (which
-//! split overlapping particles, `detector.deblend`), without the split, and with the crowded
-//! re-fits as well (`detector.refit_crowded`).
+//! split overlapping particles, `detector.deblend`, and re-fit the crowded ones,
+//! `detector.refit_crowded`), without the re-fits, and without either.
 //! Run with `cargo bench -p sillage-detect --bench blob`.
 
 #[path = "../tests/common/mod.rs"]
@@ -70,8 +70,8 @@ fn bench_deblend(c: &mut Criterion) {
     group.sample_size(10);
     let settings = [
         ("no_deblend", false, false),
-        ("defaults", true, false),
-        ("refit_crowded", true, true),
+        ("no_refit", true, false),
+        ("defaults", true, true),
     ];
     for (name, deblend, refit_crowded) in settings {
         let mut detector = BlobDetector::new(BlobParams {

@@ -341,24 +341,52 @@ fn background_subtraction_removes_a_static_scene() {
     assert!(fresh.background().is_some());
 }
 
+/// σ 2 px spots 24 px apart, every other one with a second spot 5 px away (within the
+/// re-fit's 3σ); the single ones let the splitter measure the noise.
+fn crowded_pairs(rng: &mut Rng) -> Vec<Spot> {
+    let mut spots = Vec::new();
+    for gy in 1..12 {
+        for gx in 1..12 {
+            let (x, y) = (
+                (gx * 24) as f64 + rng.uniform(),
+                (gy * 24) as f64 + rng.uniform(),
+            );
+            spots.push(Spot {
+                x,
+                y,
+                amplitude: 0.8,
+            });
+            if (gx + gy) % 2 == 0 {
+                spots.push(Spot {
+                    x: x + 5.0,
+                    y: y + 0.5,
+                    amplitude: 0.6,
+                });
+            }
+        }
+    }
+    spots
+}
+
 #[test]
-fn crowded_re_fits_without_the_splitter_are_refused_naming_both_keys() {
-    let params = BlobParams {
-        deblend: false,
-        refit_crowded: true,
-        ..BlobParams::default()
+fn crowded_re_fits_belong_to_the_splitter_and_change_nothing_without_it() {
+    let mut rng = Rng(11);
+    let spots = crowded_pairs(&mut rng);
+    let image = render(300, 300, 0.1, &spots, 2.0, 0.02, &mut rng);
+    let with = |deblend, refit_crowded| {
+        detect(
+            BlobParams {
+                deblend,
+                refit_crowded,
+                ..BlobParams::default()
+            },
+            &image,
+        )
     };
-    let Err(error) = BlobDetector::new(params) else {
-        panic!("refit_crowded without deblend was accepted");
-    };
-    let message = error.to_string();
-    assert!(
-        message.contains("refit_crowded") && message.contains("deblend = true"),
-        "{message}"
-    );
-    let with_splitter = BlobParams {
-        refit_crowded: true,
-        ..BlobParams::default()
-    };
-    assert!(BlobDetector::new(with_splitter).is_ok());
+    // Without the splitter the key is accepted and has no effect (so that turning the
+    // splitter off alone is enough).
+    assert_eq!(with(false, true), with(false, false));
+    // With it, the crowded detections move.
+    let (refitted, plain) = (with(true, true), with(true, false));
+    assert!(refitted != plain, "the re-fit moved nothing");
 }

@@ -92,7 +92,8 @@ fn fast_vortex_with_displacement_voting_meets_the_p_inverse_claim() {
     assert!(voting.true_recovery_rate.unwrap() > 0.6);
     assert!(voting.mean_position_error_px.unwrap() < 0.5);
     // The defaults measure the displacements on the first two frames and vote by themselves
-    // (measured 63.5 % / 5.5 %).
+    // (measured 73.6 % / 4.1 % since 2026-11-30 evening, when the vote began to widen by where
+    // its displacements land; 63.5 % / 5.5 % before).
     assert!(automatic.false_recovery_rate.unwrap() < 0.06);
     assert!(automatic.true_recovery_rate.unwrap() > 0.6);
     // Voting alone leaves links whose far end is a neighbour within |v|/2 (mean displacement
