@@ -104,6 +104,22 @@ fn fast_vortex_with_displacement_voting_meets_the_p_inverse_claim() {
     assert!(voting_ratio.mean_displacement_error_px.unwrap() < 0.5);
 }
 
+/// Faster still (δ = 0.3, p⁻¹ ≈ 6.75): particles move further than even the automatic
+/// vote's wide search, so both of its first votes land their points about at random. The
+/// narrow one is aliased, and the wide one must be taken (voting then stays on over twice
+/// its displacements); keeping the narrow one tracks nothing (1 % true, 97 % false).
+#[test]
+fn a_vortex_faster_than_every_first_vote_still_widens_it() {
+    let params = VortexParams {
+        delta: 0.3,
+        ..paper_vortex(4.0, 11)
+    };
+    let automatic = vortex_accuracy(&params, &PipelineConfig::default());
+    eprintln!("the defaults:\n{automatic}");
+    assert!(automatic.true_recovery_rate.unwrap() > 0.3);
+    assert!(automatic.false_recovery_rate.unwrap() < 0.25);
+}
+
 /// The paper's intermittency claim (§4.1.2, Fig. 4): at 50 % of the particles re-seeded at
 /// random every frame, false recoveries stay at or below 12 %. TracTrac's adaptive outlier
 /// threshold is inflated by the random links themselves; the ambiguity test is what works.

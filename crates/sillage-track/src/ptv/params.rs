@@ -164,7 +164,8 @@ impl VoteSearch {
     pub const OFF: VoteSearch = VoteSearch::Mode(VoteMode::Off);
     /// The first two frames are voted on from zero motion within 0.9 mean spacings, or within
     /// four (16–64 px) when that vote carries a tenth more of the points onto a point of the
-    /// second frame: when the 95th percentile of the voted displacements reaches
+    /// second frame, or when the narrow one lands hardly more than random displacements
+    /// would: when the 95th percentile of the voted displacements reaches
     /// [`AUTO_VOTE_FIRST_LINK_SPACINGS`] of the spacing the vote predicts the first link, and
     /// when it reaches [`AUTO_VOTE_SPACINGS`] voting stays on with a search radius of
     /// [`AUTO_VOTE_MARGIN`] × that displacement; else it is off. A vote that resolved less
