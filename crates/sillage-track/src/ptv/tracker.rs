@@ -487,8 +487,9 @@ impl PtvTracker {
     }
 
     /// The automatic voting decision ([`VoteSearch::AUTO`]) on the first two frames: a vote
-    /// from zero motion within 0.9 spacings, or over four where that one lands more points
-    /// ([`Self::widened_if_it_lands_more`]), measures the displacements (95th percentile).
+    /// from zero motion within 0.9 spacings, or over four where that one lands more points or
+    /// the first lands about at random ([`Self::widened_if_it_lands_more`]), measures the
+    /// displacements (95th percentile).
     /// When they reach [`AUTO_VOTE_FIRST_LINK_SPACINGS`] of the spacing, the vote predicts this
     /// first link (and seeds the motion model), as voting does; when they reach
     /// [`AUTO_VOTE_SPACINGS`], voting stays on for the rest of the run. Neither when the vote
@@ -500,7 +501,7 @@ impl PtvTracker {
         // A search within one spacing first: a regular pattern (a calibration grid) votes
         // as much for its period as for the true displacement, and slow flows need no more.
         // The wide search is taken only when its displacements carry clearly more points
-        // onto the next frame's.
+        // onto the next frame's, or when the narrow one's land hardly more than at random.
         let near_radius = (AUTO_VOTE_NEAR_SPACINGS * spacing).max(AUTO_VOTE_NEAR_MIN_PX);
         let far_radius = (AUTO_VOTE_FIRST_SPACINGS * spacing)
             .clamp(AUTO_VOTE_FIRST_MIN_PX, AUTO_VOTE_FIRST_MAX_PX);
