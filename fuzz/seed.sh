@@ -200,6 +200,18 @@ write("rgba8.png", png(size, size, 8, 6, [bytes(v for p in l for v in (p, p, p, 
 write("palette.png", png(size, size, 8, 3, [bytes(p // 16 for p in l) for l in lines],
                          palette=bytes(v for i in range(16) for v in (16 * i, 16 * i, 255 - 16 * i))))
 
+# BMPs of the crop (the format of many PIV cameras): 8-bit with a grey palette, 24-bit BGR,
+# rows bottom-up, each padded to 4 bytes.
+def bmp(width, height, bpp, rows, palette=b""):
+    pad = b"\0" * (-len(rows[0]) % 4)
+    pixels = b"".join(row + pad for row in reversed(rows))
+    offset = 14 + 40 + len(palette)
+    info = struct.pack("<IiiHHIIiiII", 40, width, height, 1, bpp, 0, len(pixels), 2835, 2835,
+                       len(palette) // 4, 0)
+    return b"BM" + struct.pack("<IHHI", offset + len(pixels), 0, 0, offset) + info + palette + pixels
+write("grey8.bmp", bmp(size, size, 8, lines, bytes(v for i in range(256) for v in (i, i, i, 0))))
+write("bgr24.bmp", bmp(size, size, 24, [bytes(v for p in l for v in (255 - p, p // 2, p)) for l in lines]))
+
 # A PETS 2009 frame's JPEG headers with its frame size set to 16 x 16 or 32 x 32, the start of
 # its entropy-coded data, then the end marker: the decoder reads the first 16 x 16 blocks.
 jpeg = open(jpeg_path, "rb").read()

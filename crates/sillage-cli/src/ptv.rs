@@ -107,6 +107,9 @@ pub fn run(args: &PtvArgs) -> Result<()> {
             eprintln!("warning: {warning}");
         }
     }
+    if let Some(warning) = run.too_few_frames_warning() {
+        eprintln!("warning: {warning}");
+    }
     if let Some(window) = args.windows.window {
         return run_windowed(args, run, format, window);
     }

@@ -144,6 +144,31 @@ fn particle_images_too_dense_for_ptv_are_warned_about() {
     );
 }
 
+/// OpenPIV's real image pair (8-bit BMP, `../shared/data/piv_openpiv_test1`): read, measured,
+/// and told that two frames form no track.
+#[test]
+fn a_piv_image_pair_in_bmp_is_read_and_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/piv_openpiv_test1"
+    );
+    let tracks = dir.path().join("pair_track.txt");
+    let pattern = format!("{data}/exp1_001_*.bmp");
+    let out = sillage(&["ptv", &pattern, "--out", path_str(&tracks)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(
+        message.contains("particle images measured on the first frame"),
+        "{message}"
+    );
+    assert!(
+        message.contains("warning: 2 frame(s): PTV links each particle over 3 frames"),
+        "{message}"
+    );
+    assert!(message.contains("2 frames, "), "{message}");
+}
+
 #[test]
 fn a_tractrac_par_file_and_a_tractrac_track_file_are_read() {
     let dir = tempfile::tempdir().unwrap();

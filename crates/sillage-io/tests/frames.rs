@@ -95,6 +95,42 @@ fn jpeg_is_read() {
 }
 
 #[test]
+fn bmp_folder_is_read_in_order_grey_and_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    gray8(&dir.path().join("exp_002.bmp"), 6, 4, 200);
+    image::RgbImage::from_pixel(6, 4, image::Rgb([255, 0, 0]))
+        .save(dir.path().join("exp_001.bmp"))
+        .unwrap();
+    let frames: Vec<_> = open(dir.path()).unwrap().map(Result::unwrap).collect();
+    assert_eq!(frames.len(), 2);
+    assert!((frames[0].image.get(5, 3) - 0.299).abs() < 1e-6);
+    assert!((frames[1].image.get(0, 0) - 200.0 / 255.0).abs() < 1e-6);
+}
+
+/// OpenPIV's test pair (`../shared/data/piv_openpiv_test1`): 8-bit palette BMPs from a real
+/// PIV camera, 511 × 369.
+#[test]
+fn real_piv_bmp_pair_is_read() {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/piv_openpiv_test1"
+    );
+    let pattern = format!("{dir}/exp1_001_*.bmp");
+    let source = open_frames(&pattern, &FrameOptions::default()).unwrap();
+    assert_eq!(source.len(), Some(2));
+    assert_eq!(source.dimensions(), (511, 369));
+    for frame in source {
+        let image = frame.unwrap().image;
+        let (lo, hi) = image
+            .as_slice()
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        // Particles on a dark background: the grey levels span most of the range.
+        assert!(lo < 0.1 && hi > 0.5, "grey levels {lo}..{hi}");
+    }
+}
+
+#[test]
 fn three_page_tiff_stack_gives_three_frames() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("stack.tif");
@@ -214,7 +250,7 @@ fn missing_and_empty_inputs_fail_clearly() {
     assert_eq!(
         err,
         format!(
-            "no frames found in {}; expected .tif/.png/.jpg files",
+            "no frames found in {}; expected .tif/.png/.jpg/.bmp files",
             dir.path().display()
         )
     );

@@ -384,6 +384,8 @@ def test_track_runs_every_tracker_on_real_frames_repeatably(tracker, source, key
 
 @pytest.mark.parametrize("detector, source, keywords", [
     ("blob", DATA / "trackpy_bulk_water" / "frames", {"polarity": "dark", "scale_px": 4.0}),
+    # OpenPIV's real image pair: 8-bit BMP, size and polarity measured.
+    ("blob", DATA / "piv_openpiv_test1", {}),
     ("bead", BEADS / "images",
      {"sequence_params": BEADS / "sequence_param.txt", "mask": BEADS / "sequence_base_mask.tif"}),
     ("motion", PETS, {"min_blob_px": 200}),

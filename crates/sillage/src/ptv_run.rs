@@ -21,6 +21,10 @@ use crate::tracking::Tracking;
 use crate::tractrac::apply_par;
 use crate::windows::{Window, WindowPlan, WindowedRun, WindowedSummary};
 
+/// Fewest frames from which PTV forms tracks: a particle is linked over three frames (the
+/// paper's three-frame nearest-neighbour association).
+pub const MIN_PTV_FRAMES: usize = 3;
+
 impl Settings for PipelineConfig {
     fn validate(&self) -> Result<()> {
         PipelineConfig::validate(self)
@@ -179,6 +183,17 @@ impl PtvRun {
     /// Number of frames to track, when the source knows it (not for every video).
     pub fn frame_count(&self) -> Option<usize> {
         self.frame_count
+    }
+
+    /// A warning for run summaries when the source holds fewer than [`MIN_PTV_FRAMES`]
+    /// frames, from which no track can form (a PIV image pair, say); `None` otherwise.
+    pub fn too_few_frames_warning(&self) -> Option<String> {
+        let frames = self.frame_count.filter(|&n| n < MIN_PTV_FRAMES)?;
+        Some(format!(
+            "{frames} frame(s): PTV links each particle over {MIN_PTV_FRAMES} frames (the \
+             paper's three-frame association), so no track can form; give at least \
+             {MIN_PTV_FRAMES} frames, or measure an image pair by cross-correlation (PIV)"
+        ))
     }
 
     /// The header of the track files of this run ([`track_header`]).

@@ -1,4 +1,4 @@
-//! Decoding one image file (PNG, JPEG, single-page TIFF) or one TIFF page into a [`GrayImage`]
+//! Decoding one image file (PNG, JPEG, BMP, single-page TIFF) or one TIFF page into a [`GrayImage`]
 //! (1-bit TIFFs with CCITT modified Huffman compression through [`super::ccitt`]), and on
 //! request into an 8-bit [`RgbImage`] as well.
 //!
@@ -184,7 +184,7 @@ pub(crate) fn decode_tiff_page<R: std::io::Read + std::io::Seek>(
     }
 }
 
-/// Converts a decoded PNG/JPEG (or any `image` crate picture) to grey, and to colour when
+/// Converts a decoded PNG/JPEG/BMP (or any `image` crate picture) to grey, and to colour when
 /// `colour` is true.
 fn decode_dynamic(image: image::DynamicImage, colour: bool) -> DecodeResult<Decoded> {
     use image::DynamicImage as D;
@@ -295,7 +295,7 @@ fn unsupported(what: &str) -> String {
     )
 }
 
-/// Reads one image file (PNG, JPEG or the first page of a TIFF) as a grey image in `[0, 1]`:
+/// Reads one image file (PNG, JPEG, BMP or the first page of a TIFF) as a grey image in `[0, 1]`:
 /// used for masks and single frames.
 pub fn read_image(path: impl AsRef<Path>) -> Result<GrayImage> {
     let path = path.as_ref();
@@ -306,8 +306,8 @@ pub fn read_image(path: impl AsRef<Path>) -> Result<GrayImage> {
 }
 
 /// Decodes one image held in `bytes` as [`read_image`] decodes a file: `path` names it in
-/// errors, and its extension tells a TIFF (`.tif`, `.tiff`, first page decoded) from PNG and
-/// JPEG, whose format is read from the bytes.
+/// errors, and its extension tells a TIFF (`.tif`, `.tiff`, first page decoded) from PNG,
+/// JPEG and BMP, whose format is read from the bytes.
 pub fn read_image_from_bytes(path: &Path, bytes: &[u8]) -> Result<GrayImage> {
     decode_reader(path, std::io::Cursor::new(bytes), false)
         .map(|decoded| decoded.grey)
@@ -318,7 +318,7 @@ fn decode_error(path: &Path, message: &str) -> sillage_core::Error {
     sillage_core::Error::format(
         path,
         None,
-        format!("cannot decode: {message}; check that it is a valid PNG, JPEG or TIFF image"),
+        format!("cannot decode: {message}; check that it is a valid PNG, JPEG, BMP or TIFF image"),
     )
 }
 

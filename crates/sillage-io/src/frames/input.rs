@@ -9,7 +9,7 @@ use sillage_core::{Error, Result};
 use super::decode::{has_extension, is_tiff};
 
 /// Extensions of image files taken from a folder or a glob match.
-pub(crate) const IMAGE_EXTENSIONS: &[&str] = &["tif", "tiff", "png", "jpg", "jpeg"];
+pub(crate) const IMAGE_EXTENSIONS: &[&str] = &["tif", "tiff", "png", "jpg", "jpeg", "bmp"];
 
 /// Extensions read as video through `ffmpeg`.
 pub(crate) const VIDEO_EXTENSIONS: &[&str] = &["avi", "mp4", "mov", "mkv"];
@@ -53,7 +53,7 @@ pub(crate) fn resolve(input: &str) -> Result<InputKind> {
         return Ok(InputKind::Files(vec![path.to_path_buf()]));
     }
     Err(Error::input(format!(
-        "{}: unsupported input; give a folder of .tif/.png/.jpg frames, a glob pattern in quotes \
+        "{}: unsupported input; give a folder of .tif/.png/.jpg/.bmp frames, a glob pattern in quotes \
          (\"dir/*.tif\"), a multi-page TIFF or a video (.avi/.mp4/.mov/.mkv)",
         path.display()
     )))
@@ -84,7 +84,7 @@ fn resolve_folder(dir: &Path) -> Result<InputKind> {
     }
     if files.is_empty() {
         return Err(Error::input(format!(
-            "no frames found in {}; expected .tif/.png/.jpg files",
+            "no frames found in {}; expected .tif/.png/.jpg/.bmp files",
             dir.display()
         )));
     }
@@ -107,7 +107,7 @@ fn resolve_glob(pattern: &str) -> Result<InputKind> {
     }
     if files.is_empty() {
         return Err(Error::input(format!(
-            "no frames found matching {pattern}; expected .tif/.png/.jpg files"
+            "no frames found matching {pattern}; expected .tif/.png/.jpg/.bmp files"
         )));
     }
     files.sort_by(|a, b| natural_cmp(&a.to_string_lossy(), &b.to_string_lossy()));

@@ -97,7 +97,7 @@ pub struct FrameSource {
     ended: bool,
 }
 
-/// Opens `input`: a folder (its .tif/.tiff/.png/.jpg/.jpeg files in natural name order), a
+/// Opens `input`: a folder (its .tif/.tiff/.png/.jpg/.jpeg/.bmp files in natural name order), a
 /// glob pattern (`"dir/*.tif"`), a single image, a multi-page TIFF (one frame per page) or a
 /// video (.avi/.mp4/.mov/.mkv, read through `ffmpeg`).
 ///
