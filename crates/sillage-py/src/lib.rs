@@ -23,6 +23,7 @@ use sillage::config::OPTIONAL_KEYS;
 use sillage::core::{FrameIndex, Point2, TrackId, TrackPoint, Vec2};
 use sillage::detect::blob::Calibration;
 use sillage::io::{FrameOptions, open_frames};
+use sillage::ptv_run::too_few_frames_warning;
 use sillage::toml_config::dotted_keys;
 use sillage::{Pipeline, PipelineConfig};
 
@@ -150,6 +151,12 @@ fn ptv<'py>(
         summary.measured_displacement_px,
         summary.vote_search_px,
     )?;
+    let frames = usize::try_from(summary.frames).unwrap_or(usize::MAX);
+    if let Some(warning) = too_few_frames_warning(frames)
+        && let Some(measured) = columns.get_item("measured")?
+    {
+        measured.set_item("frames_warning", warning)?;
+    }
     Ok(columns)
 }
 

@@ -403,6 +403,12 @@ def test_detect_runs_every_detector_on_real_frames(detector, source, keywords):
         assert set(found["class"]) == {0, 1}
 
 
+def test_ptv_on_an_image_pair_warns_that_no_track_can_form():
+    with pytest.warns(UserWarning, match="2 frame\\(s\\): PTV links each particle over 3 frames"):
+        tracks = sillage.ptv(str(DATA / "piv_openpiv_test1"))
+    assert len(tracks) == 0
+
+
 def test_track_and_detect_refuse_unknown_names_and_keys_with_value_errors():
     with pytest.raises(ValueError, match="unknown tracker `kalman`"):
         sillage.track(PETS, "kalman")

@@ -25,6 +25,18 @@ use crate::windows::{Window, WindowPlan, WindowedRun, WindowedSummary};
 /// paper's three-frame nearest-neighbour association).
 pub const MIN_PTV_FRAMES: usize = 3;
 
+/// A warning for run summaries when `frames` is fewer than [`MIN_PTV_FRAMES`], from which no
+/// track can form (a PIV image pair, say); `None` otherwise.
+pub fn too_few_frames_warning(frames: usize) -> Option<String> {
+    (frames < MIN_PTV_FRAMES).then(|| {
+        format!(
+            "{frames} frame(s): PTV links each particle over {MIN_PTV_FRAMES} frames (the \
+             paper's three-frame association), so no track can form; give at least \
+             {MIN_PTV_FRAMES} frames, or measure an image pair by cross-correlation (PIV)"
+        )
+    })
+}
+
 impl Settings for PipelineConfig {
     fn validate(&self) -> Result<()> {
         PipelineConfig::validate(self)
@@ -185,15 +197,9 @@ impl PtvRun {
         self.frame_count
     }
 
-    /// A warning for run summaries when the source holds fewer than [`MIN_PTV_FRAMES`]
-    /// frames, from which no track can form (a PIV image pair, say); `None` otherwise.
+    /// [`too_few_frames_warning`] for this run's source, when it knows its length.
     pub fn too_few_frames_warning(&self) -> Option<String> {
-        let frames = self.frame_count.filter(|&n| n < MIN_PTV_FRAMES)?;
-        Some(format!(
-            "{frames} frame(s): PTV links each particle over {MIN_PTV_FRAMES} frames (the \
-             paper's three-frame association), so no track can form; give at least \
-             {MIN_PTV_FRAMES} frames, or measure an image pair by cross-correlation (PIV)"
-        ))
+        self.frame_count.and_then(too_few_frames_warning)
     }
 
     /// The header of the track files of this run ([`track_header`]).

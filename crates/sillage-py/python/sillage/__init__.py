@@ -116,11 +116,13 @@ def _frame_with_measured(columns: dict, order: list[str]) -> pd.DataFrame:
     """The DataFrame of ``columns`` in ``order``; what the run measured from the frames
     (``particle_sigma_px``, ``scale_px``, ``polarity``, ``source_density``, and for PTV
     ``displacement_px`` and ``vote_search_px``) goes to its ``attrs``; particle images too dense
-    for PTV (see ``source_density``) raise a ``UserWarning``."""
+    for PTV (see ``source_density``) and PTV on fewer than three frames raise a
+    ``UserWarning``."""
     measured = columns.pop("measured", {})
-    warning = measured.pop("density_warning", None)
-    if warning:
-        warnings.warn(warning, stacklevel=3)
+    for key in ("density_warning", "frames_warning"):
+        warning = measured.pop(key, None)
+        if warning:
+            warnings.warn(warning, stacklevel=3)
     frame = _columns_frame(columns, order)
     frame.attrs.update(measured)
     return frame
