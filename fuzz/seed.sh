@@ -208,9 +208,11 @@ def bmp(width, height, bpp, rows, palette=b""):
     offset = 14 + 40 + len(palette)
     info = struct.pack("<IiiHHIIiiII", 40, width, height, 1, bpp, 0, len(pixels), 2835, 2835,
                        len(palette) // 4, 0)
-    return b"BM" + struct.pack("<IHHI", offset + len(pixels), 0, 0, offset) + info + palette + pixels
+    header = struct.pack("<IHHI", offset + len(pixels), 0, 0, offset)
+    return b"BM" + header + info + palette + pixels
 write("grey8.bmp", bmp(size, size, 8, lines, bytes(v for i in range(256) for v in (i, i, i, 0))))
-write("bgr24.bmp", bmp(size, size, 24, [bytes(v for p in l for v in (255 - p, p // 2, p)) for l in lines]))
+write("bgr24.bmp", bmp(size, size, 24,
+                      [bytes(v for p in l for v in (255 - p, p // 2, p)) for l in lines]))
 
 # A PETS 2009 frame's JPEG headers with its frame size set to 16 x 16 or 32 x 32, the start of
 # its entropy-coded data, then the end marker: the decoder reads the first 16 x 16 blocks.

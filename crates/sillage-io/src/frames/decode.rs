@@ -1,5 +1,5 @@
-//! Decoding one image file (PNG, JPEG, BMP, single-page TIFF) or one TIFF page into a [`GrayImage`]
-//! (1-bit TIFFs with CCITT modified Huffman compression through [`super::ccitt`]), and on
+//! Decoding one image file (PNG, JPEG, BMP, single-page TIFF) or one TIFF page into a
+//! [`GrayImage`] (1-bit TIFFs with CCITT modified Huffman compression through [`super::ccitt`]), and on
 //! request into an 8-bit [`RgbImage`] as well.
 //!
 //! Grey levels are normalised to `[0, 1]`: 8-bit values are divided by 255, 16-bit by 65535;
@@ -295,8 +295,8 @@ fn unsupported(what: &str) -> String {
     )
 }
 
-/// Reads one image file (PNG, JPEG, BMP or the first page of a TIFF) as a grey image in `[0, 1]`:
-/// used for masks and single frames.
+/// Reads one image file (PNG, JPEG, BMP or the first page of a TIFF) as a grey image in
+/// `[0, 1]`: used for masks and single frames.
 pub fn read_image(path: impl AsRef<Path>) -> Result<GrayImage> {
     let path = path.as_ref();
     super::input::check_exists(path)?;

@@ -53,8 +53,8 @@ pub(crate) fn resolve(input: &str) -> Result<InputKind> {
         return Ok(InputKind::Files(vec![path.to_path_buf()]));
     }
     Err(Error::input(format!(
-        "{}: unsupported input; give a folder of .tif/.png/.jpg/.bmp frames, a glob pattern in quotes \
-         (\"dir/*.tif\"), a multi-page TIFF or a video (.avi/.mp4/.mov/.mkv)",
+        "{}: unsupported input; give a folder of .tif/.png/.jpg/.bmp frames, a glob pattern in \
+         quotes (\"dir/*.tif\"), a multi-page TIFF or a video (.avi/.mp4/.mov/.mkv)",
         path.display()
     )))
 }

@@ -97,8 +97,8 @@ pub struct FrameSource {
     ended: bool,
 }
 
-/// Opens `input`: a folder (its .tif/.tiff/.png/.jpg/.jpeg/.bmp files in natural name order), a
-/// glob pattern (`"dir/*.tif"`), a single image, a multi-page TIFF (one frame per page) or a
+/// Opens `input`: a folder (its .tif/.tiff/.png/.jpg/.jpeg/.bmp files in natural name order),
+/// a glob pattern (`"dir/*.tif"`), a single image, a multi-page TIFF (one frame per page) or a
 /// video (.avi/.mp4/.mov/.mkv, read through `ffmpeg`).
 ///
 /// Pixels become grey levels in `[0, 1]`: 8-bit values / 255, 16-bit / 65535, 32-bit float
