@@ -104,7 +104,9 @@ pub const DENSE_SOURCE_DENSITY: f64 = 0.5;
 /// 0.60 and 0.59 (0.60 with every blob), at 0.2 0.54, at 0.3 0.45, below it; the densest
 /// solvable case stays at 0.40. On the report halves (never used to choose) the five cases the
 /// defaults cannot solve (≤ 8 % true recoveries) measure 0.59–0.68 and the other 31 at most
-/// 0.47, as before: the same warnings. On trackpy's tutorial movie (dark spheres on a textured,
+/// 0.47, as before: the same warnings (8 of the main family's 12 report cases share their
+/// first frame with a tune case; the two unsolvable ones with a frame of their own read 0.60
+/// and 0.62). On trackpy's tutorial movie (dark spheres on a textured,
 /// compressed background, about 524 per frame for trackpy), 1,342 of the first frame's 3,824
 /// dark blobs count, of σ 2.07 px: 0.27, where every blob gave a false warning at 0.51.
 pub const PARTICLE_SHARE: f64 = 0.1;
