@@ -86,9 +86,10 @@ impl Profiles {
         self.cols.resize(side, 1.0);
         self.rows.resize(side, 1.0);
         let inv2 = 1.0 / (2.0 * s * s);
+        let step = (-2.0 * inv2).exp();
         for centre in centres {
-            push_axis(&mut self.cols, side, window.x0, centre.x, inv2);
-            push_axis(&mut self.rows, side, window.y0, centre.y, inv2);
+            push_axis(&mut self.cols, side, window.x0, centre.x, inv2, step);
+            push_axis(&mut self.rows, side, window.y0, centre.y, inv2, step);
         }
     }
 
@@ -242,8 +243,9 @@ fn project_avx512_n<const N: usize>(
 
 /// Appends a component's three profiles along one axis: g, g·d, g·d² at the `side` pixels
 /// from `origin`, d the offset from `at`. The Gaussian by its recurrence, g(d + 1) = g(d) ·
-/// r(d) with r(d + 1) = r(d) · e^(−1/s²) (`inv2` = 1/2s²): three exponentials, not `side`.
-fn push_axis(profiles: &mut Vec<f64>, side: usize, origin: usize, at: f64, inv2: f64) {
+/// r(d) with r(d + 1) = r(d) · `step` (`inv2` = 1/2s², `step` = e^(−1/s²), the same for every
+/// component): two exponentials, not `side`.
+fn push_axis(profiles: &mut Vec<f64>, side: usize, origin: usize, at: f64, inv2: f64, step: f64) {
     let start = profiles.len();
     profiles.resize(start + 3 * side, 0.0);
     let (g, rest) = profiles[start..].split_at_mut(side);
@@ -251,7 +253,6 @@ fn push_axis(profiles: &mut Vec<f64>, side: usize, origin: usize, at: f64, inv2:
     let d0 = origin as f64 - at;
     let mut value = (-d0 * d0 * inv2).exp();
     let mut ratio = (-(2.0 * d0 + 1.0) * inv2).exp();
-    let step = (-2.0 * inv2).exp();
     for k in 0..side {
         let d = d0 + k as f64;
         (g[k], gd[k], gd2[k]) = (value, value * d, value * d * d);
@@ -403,8 +404,8 @@ impl Model<'_> {
             theta[4 + 3 * c] = centre.y;
         }
         let mut lambda = 1e-3;
-        self.evaluate(&theta, profiles);
-        let (mut residual, mut system) = self.system(&theta, profiles);
+        let mut residual = self.evaluate(&theta, profiles);
+        let mut system = self.system(&theta, profiles);
         for _ in 0..MAX_ITERATIONS {
             let mut damped = system.normal;
             for d in 0..n {
@@ -427,13 +428,13 @@ impl Model<'_> {
             };
             if tried < residual {
                 let gain = residual - tried;
-                theta = trial;
-                // `evaluate` left the profiles at the trial, now θ.
-                (residual, system) = self.system(&theta, profiles);
-                lambda = (lambda * 0.1).max(1e-9);
+                (theta, residual) = (trial, tried);
                 if gain < self.tolerance {
                     break;
                 }
+                // `evaluate` left the profiles at the trial, now θ.
+                system = self.system(&theta, profiles);
+                lambda = (lambda * 0.1).max(1e-9);
             } else {
                 lambda *= 10.0;
                 if lambda > 1e6 {
@@ -466,7 +467,7 @@ impl Model<'_> {
         out
     }
 
-    /// The squared residual at θ.
+    /// The squared residual at θ (the profiles set and prepared there).
     fn evaluate(&self, theta: &Params, profiles: &mut Profiles) -> f64 {
         self.set_profiles(theta, profiles);
         let mut which = [0; 1 + MAX_FREE];
@@ -474,21 +475,33 @@ impl Model<'_> {
             which[1 + c] = profile(c, 0);
         }
         profiles.prepare(self.window, &which[..1 + self.free]);
+        self.residual(theta, profiles)
+    }
+
+    /// The squared residual at θ from the Gaussians' profiles as [`Model::evaluate`] leaves
+    /// them: Σz² − 2 Σ αₘ⟨z, tₘ⟩ + Σₘ αₘ Σₖ αₖ⟨tₖ, tₘ⟩ over the model's terms tₘ and
+    /// coefficients αₘ, in that order (one formula for every caller, so that the residual of
+    /// an accepted trial is the one its system would give, bit for bit).
+    fn residual(&self, theta: &Params, profiles: &Profiles) -> f64 {
         let coefficients = self.coefficients(theta);
         let coefficients = &coefficients[..1 + self.free];
         let mut total = self.window.sum_sq;
+        let mut model_gram = [0.0; 1 + MAX_FREE];
         for &(_, a, alpha) in coefficients {
             total -= 2.0 * alpha * profiles.data(a);
-            for &(_, b, beta) in coefficients {
-                total += alpha * beta * profiles.gram(a, b);
+            for (sum, &(_, b, _)) in model_gram.iter_mut().zip(coefficients) {
+                *sum += alpha * profiles.gram(a, b);
             }
+        }
+        for (&(_, _, alpha), &sum) in coefficients.iter().zip(&model_gram) {
+            total += alpha * sum;
         }
         total.max(0.0)
     }
 
-    /// The squared residual at θ, with JᵀJ and Jᵀr, from `profiles` as [`Model::evaluate`]
-    /// at the same θ leaves them (the Gaussians' profiles prepared; the others are added).
-    fn system(&self, theta: &Params, profiles: &mut Profiles) -> (f64, System) {
+    /// JᵀJ and Jᵀr at θ, from `profiles` as [`Model::evaluate`] at the same θ leaves them
+    /// (the Gaussians' profiles prepared; the others are added).
+    fn system(&self, theta: &Params, profiles: &mut Profiles) -> System {
         let mut done = [0; 1 + MAX_FREE];
         let mut new = [0; 2 * MAX_FREE];
         for c in 0..self.free {
@@ -516,17 +529,11 @@ impl Model<'_> {
         // The model on the terms (constant and Gaussians), its fit to the data and the
         // residual's projection on every term.
         let coefficients = self.coefficients(theta);
-        let coefficients = &coefficients[..1 + self.free];
         let mut model_gram = [0.0; MAX_TERMS];
-        let mut total = self.window.sum_sq;
-        for &(m, _, alpha) in coefficients {
-            total -= 2.0 * alpha * data[m];
+        for &(m, _, alpha) in &coefficients[..1 + self.free] {
             for k in 0..term_count {
                 model_gram[k] += alpha * gram[m][k];
             }
-        }
-        for &(m, _, alpha) in coefficients {
-            total += alpha * model_gram[m];
         }
         // ∂model/∂θ as combinations of the terms: background → constant; width → Σ a/s³
         // (g·dx² + g·dy²); amplitude → g; x → a/s² g·dx; y → a/s² g·dy.
@@ -568,7 +575,7 @@ impl Model<'_> {
                 system.normal[l * n + k] = value;
             }
         }
-        (total.max(0.0), system)
+        system
     }
 }
 
@@ -701,9 +708,9 @@ mod tests {
             let theta: Params = [0.12, 2.3, 0.7, 26.0, 41.0, 0.4, 29.4, 41.7];
             let (residual, normal, gradient) = direct(&window, &model, &theta);
             let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * (1.0 + a.abs().max(b.abs()));
-            assert!(close(model.evaluate(&theta, &mut profiles), residual));
-            let (separable, system) = model.system(&theta, &mut profiles);
+            let separable = model.evaluate(&theta, &mut profiles);
             assert!(close(separable, residual), "{separable} vs {residual}");
+            let system = model.system(&theta, &mut profiles);
             let n = model.parameters();
             for a in 0..n {
                 assert!(
