@@ -106,6 +106,7 @@ fn output_on_fixed_scenes_is_unchanged() {
         vote_search_px: VoteSearch::OFF,
         velocity_window: 3,
         warm_up_frames: 0,
+        restore_flanked: false,
         ..Default::default()
     };
     let default = track(&frames, tractrac.clone(), 1);
@@ -114,6 +115,16 @@ fn output_on_fixed_scenes_is_unchanged() {
         &frames,
         PtvParams {
             velocity_window: PtvParams::default().velocity_window,
+            ..tractrac.clone()
+        },
+        1,
+    );
+    // And the rejected points a trajectory vouches for written.
+    let restored = track(
+        &frames,
+        PtvParams {
+            velocity_window: PtvParams::default().velocity_window,
+            restore_flanked: true,
             ..tractrac.clone()
         },
         1,
@@ -133,6 +144,7 @@ fn output_on_fixed_scenes_is_unchanged() {
         (default.len(), fingerprint(&default)),
         (iterated.len(), fingerprint(&iterated)),
         (fitted.len(), fingerprint(&fitted)),
+        (restored.len(), fingerprint(&restored)),
     ];
     println!("{got:?}");
     assert!(default.len() > 100_000);
@@ -148,9 +160,12 @@ fn output_on_fixed_scenes_is_unchanged() {
 /// trajectory's ends started to reach further on the side it has (positions and ids
 /// unchanged). All three re-pinned on 2026-11-30, when a tracklet whose prediction errs by
 /// less than 0.1 px stopped being an outlier (`SURE_LINK_LOG_ERR`; these detections are
-/// exact, so such links are right): 116,883 → 116,898 and 116,093 → 116,523 points.
-const EXPECTED: [(usize, u64); 3] = [
+/// exact, so such links are right): 116,883 → 116,898 and 116,093 → 116,523 points. The
+/// fourth, with the rejected points a trajectory vouches for written (`restore_flanked`),
+/// added on 2026-12-01 with that parameter.
+const EXPECTED: [(usize, u64); 4] = [
     (116_898, 7_732_528_358_411_815_209),
     (116_523, 13_837_768_037_016_009_985),
     (116_898, 13_913_804_998_168_621_735),
+    (117_034, 14_047_780_696_869_507_909),
 ];

@@ -369,13 +369,15 @@ fn noisy_translation(vel: Vec2, noise: f64) -> Scene {
 fn kinematics_fitted_along_trajectories_carry_far_less_position_noise() {
     let vel = Vec2::new(1.5, -0.7);
     let scene = noisy_translation(vel, 0.3);
-    let track = |velocity_window: usize| {
+    let track = |velocity_window: usize, restore_flanked: bool| {
         scene.track(PtvParams {
             velocity_window,
+            restore_flanked,
             ..PtvParams::default()
         })
     };
-    let (eq6, fitted) = (track(3), track(PtvParams::default().velocity_window));
+    let window = PtvParams::default().velocity_window;
+    let (eq6, fitted) = (track(3, false), track(window, false));
     assert!(eq6.len() > 7000, "{} of 7,200 points", eq6.len());
     // The mean length of `vector` over the points.
     let mean_norm = |points: &[TrackPoint], vector: &dyn Fn(&TrackPoint) -> Vec2| {
@@ -410,6 +412,23 @@ fn kinematics_fitted_along_trajectories_carry_far_less_position_noise() {
         )
     };
     assert!(eq6.iter().map(key).eq(fitted.iter().map(key)));
+    // Restoring the rejected points a trajectory vouches for only adds points.
+    let restored = track(window, true);
+    let restored_keys: std::collections::HashSet<_> = restored.iter().map(key).collect();
+    assert!(fitted.iter().all(|p| restored_keys.contains(&key(p))));
+    let fitted_keys: std::collections::HashSet<_> = fitted.iter().map(key).collect();
+    let added: Vec<TrackPoint> = restored
+        .into_iter()
+        .filter(|p| !fitted_keys.contains(&key(p)))
+        .collect();
+    // In a uniform translation every rejection is the noise's: the points restored are
+    // right, their velocities as good as the others'.
+    assert!(added.len() > 20, "{} points restored", added.len());
+    let added_error = mean_norm(&added, &velocity_error);
+    assert!(
+        added_error < 0.5 * eq6_error,
+        "Eq. 6: {eq6_error:.4} px/frame, restored points: {added_error:.4}"
+    );
 }
 
 #[test]

@@ -11,7 +11,9 @@
 //! 5. hands track ids over from link to link (§3.1.4) and emits frame t−1, its velocities
 //!    and accelerations fitted along each trajectory over up to `velocity_window` frames
 //!    (see `smoothing`; 3 is TracTrac's Eqs. 6–7), which holds points back
-//!    `velocity_window / 2 − 1` frames.
+//!    `velocity_window / 2 − 1` frames; a point rejected in step 4 between two kept points of
+//!    its trajectory, on a path smooth to the positions' noise, is written too
+//!    (`restore_flanked`).
 //!
 //! It follows what TracTrac's Python code does where it differs from the paper's text; each
 //! function says where. Training passes (TracTrac's `vid_loop`) are driven by the caller
@@ -26,7 +28,8 @@ mod voting;
 
 pub use params::{
     AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_MIN_VALID_SHARE, AUTO_VOTE_SPACINGS,
-    AUTO_VOTE_UNRESOLVED_SPACINGS, DEFAULT_VELOCITY_WINDOW, DEFAULT_WARM_UP_FRAMES,
-    MAX_VELOCITY_WINDOW, MAX_WARM_UP_FRAMES, PtvParams, VoteMode, VoteSearch,
+    AUTO_VOTE_UNRESOLVED_SPACINGS, DEFAULT_RESTORE_FLANKED, DEFAULT_VELOCITY_WINDOW,
+    DEFAULT_WARM_UP_FRAMES, MAX_VELOCITY_WINDOW, MAX_WARM_UP_FRAMES, PtvParams, VoteMode,
+    VoteSearch,
 };
 pub use tracker::{PassDirection, PtvTracker};

@@ -6,7 +6,8 @@ use sillage_core::{Error, NumberOrWord, Result};
 /// Parameters of [`crate::ptv::PtvTracker`]. Keys and defaults are those of TracTrac's
 /// parameter file as its command line fills them in (`set_default_parameter`), so a
 /// TracTrac `*_par.txt` maps one to one; `vote_search_px`, `ambiguity_ratio`,
-/// `max_displacement_px`, `dt`, `velocity_window` and `warm_up_frames` are additions.
+/// `max_displacement_px`, `dt`, `velocity_window`, `warm_up_frames` and `restore_flanked` are
+/// additions.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PtvParams {
@@ -59,6 +60,25 @@ pub struct PtvParams {
     /// [`DEFAULT_WARM_UP_FRAMES`]; training passes (`training_passes`) replace it.
     #[serde(default)]
     pub warm_up_frames: usize,
+    /// Write a point the outlier test rejected when its trajectory vouches for it: the
+    /// points just before and just after it were kept, and the five positions around it lie
+    /// on a path a cubic fits to within the positions' noise (their fourth difference). The
+    /// test of §3.1.3 compares a central-difference velocity with the motion model's, and
+    /// where the model errs (strong accelerations, a coarse local average) it rejects points
+    /// of trajectories it keeps on both sides. Needs the fitted velocities
+    /// (`velocity_window` ≥ 5); `false` writes what TracTrac writes. Default `true`
+    /// ([`DEFAULT_RESTORE_FLANKED`]).
+    #[serde(default = "default_restore_flanked")]
+    pub restore_flanked: bool,
+}
+
+/// The default [`PtvParams::restore_flanked`]. Decided on the tune halves of both accuracy
+/// families (no value to tune: the smoothness test uses the 3σ of the fitted velocities'
+/// window rule); see `docs/ptv.md`, "Rejected points a trajectory vouches for".
+pub const DEFAULT_RESTORE_FLANKED: bool = true;
+
+fn default_restore_flanked() -> bool {
+    DEFAULT_RESTORE_FLANKED
 }
 
 /// The default [`PtvParams::warm_up_frames`]. Chosen on the tune halves of both accuracy
@@ -106,6 +126,7 @@ impl Default for PtvParams {
             dt: 1.0,
             velocity_window: DEFAULT_VELOCITY_WINDOW,
             warm_up_frames: DEFAULT_WARM_UP_FRAMES,
+            restore_flanked: DEFAULT_RESTORE_FLANKED,
         }
     }
 }

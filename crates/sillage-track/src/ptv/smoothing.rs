@@ -33,6 +33,12 @@
 //!
 //! The fit needs the positions up to `h` frames ahead, so a point leaves `h − 1` frames later
 //! than it would with Eq. 6; [`VelocitySmoother::flush`] hands out the rest at the end.
+//!
+//! The same look at a trajectory on both sides of a point decides whether a point the outlier
+//! test rejected is written after all: when its trajectory's points just before and just after
+//! it were kept, and its fourth difference (the five positions around it) stays within
+//! [`AGREEMENT_SIGMAS`] of the positions' noise, the path through it is as smooth as a true
+//! particle's.
 
 use std::collections::VecDeque;
 
@@ -88,11 +94,15 @@ pub(crate) struct Linked {
 struct Slot {
     frame: FrameIndex,
     pos: Point2,
+    /// Whether the trajectory's point of that frame passed the outlier test (was emitted).
+    #[serde(default)]
+    kept: bool,
 }
 
 const EMPTY: Slot = Slot {
     frame: FrameIndex::MAX,
     pos: Point2 { x: 0.0, y: 0.0 },
+    kept: false,
 };
 
 /// `Σ_{k=1}^{r} k²`.
@@ -119,11 +129,29 @@ impl Around {
         Self { frame, half, slots }
     }
 
-    /// The position of a trajectory (its `ring`) at frame + `k`, if recorded.
-    fn position(&self, ring: &[Slot], k: i64) -> Option<Point2> {
+    /// The slot of a trajectory (its `ring`) at frame + `k`, if recorded.
+    fn slot(&self, ring: &[Slot], k: i64) -> Option<Slot> {
         let frame = self.frame.checked_add_signed(k)?;
         let slot = ring[self.slots[(self.half as i64 + k) as usize]];
-        (slot.frame == frame).then_some(slot.pos)
+        (slot.frame == frame).then_some(slot)
+    }
+
+    /// The position of a trajectory (its `ring`) at frame + `k`, if recorded.
+    fn position(&self, ring: &[Slot], k: i64) -> Option<Point2> {
+        self.slot(ring, k).map(|slot| slot.pos)
+    }
+
+    /// Whether a trajectory's rejected point at the frame is vouched for: its points of the
+    /// frames just before and after were kept, and its fourth difference around the frame
+    /// has a squared length within `limit` (needs `h` ≥ 2).
+    fn vouched_for(&self, ring: &[Slot], limit: f64) -> bool {
+        let kept = |k: i64| self.slot(ring, k).is_some_and(|slot| slot.kept);
+        self.half >= 2
+            && kept(-1)
+            && kept(1)
+            && self
+                .fourth_difference(ring, 0)
+                .is_some_and(|d| d.norm_squared() <= limit)
     }
 
     /// `x(c−2) − 4x(c−1) + 6x(c) − 4x(c+1) + x(c+2)` around frame + `c` (|c| ≤ h − 2):
@@ -299,6 +327,24 @@ impl OneSided {
     }
 }
 
+/// The points of `a` and `b` (each in increasing id order, ids distinct) in one list in
+/// increasing id order.
+fn merge_by_id(a: Vec<TrackPoint>, b: Vec<TrackPoint>) -> Vec<TrackPoint> {
+    let mut merged = Vec::with_capacity(a.len() + b.len());
+    let (mut a, mut b) = (a.into_iter().peekable(), b.into_iter().peekable());
+    while let (Some(x), Some(y)) = (a.peek(), b.peek()) {
+        let next = if x.track_id < y.track_id {
+            a.next()
+        } else {
+            b.next()
+        };
+        merged.extend(next);
+    }
+    merged.extend(a);
+    merged.extend(b);
+    merged
+}
+
 /// `Σ_{k=1}^{r} k⁴`.
 fn sum_of_fourth_powers(r: usize) -> f64 {
     (r * (r + 1) * (2 * r + 1) * (3 * r * r + 3 * r - 1)) as f64 / 30.0
@@ -321,12 +367,20 @@ fn parabola_spread(r: usize) -> f64 {
 pub(crate) struct VelocitySmoother {
     /// h: frames on each side of a point (1: Eq. 6, points pass straight through).
     half: usize,
+    /// Whether rejected points a trajectory vouches for are emitted (see the [module
+    /// docs](self)).
+    #[serde(default)]
+    restore: bool,
     /// Time between frames.
     dt: f64,
     /// Whether this pass fits (forward passes only: training passes' output is discarded).
     active: bool,
     /// Frames of points waiting for their windows, oldest first.
     pending: VecDeque<Vec<TrackPoint>>,
+    /// Per frame of `pending`: the points the outlier test rejected that carry an id
+    /// (increasing ids), candidates for [`Self::restore`].
+    #[serde(default)]
+    pending_rejected: VecDeque<Vec<TrackPoint>>,
     /// Emptied batches, reused.
     #[serde(skip)]
     spare: Vec<Vec<TrackPoint>>,
@@ -346,10 +400,12 @@ pub(crate) struct VelocitySmoother {
 
 impl VelocitySmoother {
     /// A smoother fitting over `window` frames (odd, ≥ 3; 3 passes points through) with
-    /// `dt` between frames.
-    pub fn new(window: usize, dt: f64) -> Self {
+    /// `dt` between frames, emitting the rejected points a trajectory vouches for when
+    /// `restore`.
+    pub fn new(window: usize, dt: f64, restore: bool) -> Self {
         Self {
             half: window / 2,
+            restore,
             dt,
             active: true,
             ..Self::default()
@@ -361,6 +417,7 @@ impl VelocitySmoother {
     pub fn start_pass(&mut self, active: bool) {
         self.active = active;
         self.pending.clear();
+        self.pending_rejected.clear();
         self.ids.clear();
         self.last_seen.clear();
         self.slots.clear();
@@ -376,18 +433,22 @@ impl VelocitySmoother {
         2 * self.half + 1
     }
 
-    /// Takes the points of frame `frames.at` (increasing ids) from `batch`, which gets an
-    /// empty buffer back, and the positions of the trajectories through that frame, `linked`
-    /// (lists each in increasing id order, the emitted points among them); hands to `sink`
-    /// the frames whose windows are now complete.
+    /// Takes the points of frame `frames.at` (increasing ids) from `batch`, and the points of
+    /// that frame the outlier test rejected that carry an id from `rejected` (increasing
+    /// ids; both get empty buffers back), with the positions of the trajectories through that
+    /// frame: `emitted`'s and `carried`'s (each in increasing id order); hands to `sink` the
+    /// frames whose windows are now complete.
     pub fn push(
         &mut self,
         frames: StepFrames,
         batch: &mut Vec<TrackPoint>,
-        linked: &[&[Linked]],
+        rejected: &mut Vec<TrackPoint>,
+        emitted: &[Linked],
+        carried: &[Linked],
         sink: &mut dyn TrackSink,
     ) -> Result<()> {
         if self.passes_through() {
+            rejected.clear();
             let result = if batch.is_empty() {
                 Ok(())
             } else {
@@ -396,12 +457,12 @@ impl VelocitySmoother {
             batch.clear();
             return result;
         }
-        for list in linked {
-            self.record(frames, list);
-        }
+        self.record(frames, emitted, true);
+        self.record(frames, carried, false);
         let mut recycled = self.spare.pop().unwrap_or_default();
         recycled.clear();
         self.pending.push_back(std::mem::replace(batch, recycled));
+        self.pending_rejected.push_back(std::mem::take(rejected));
         self.since_pruned += 1;
         if self.since_pruned >= self.ring() {
             self.prune(frames.at);
@@ -426,10 +487,14 @@ impl VelocitySmoother {
         let Some(mut points) = self.pending.pop_front() else {
             return Ok(());
         };
-        if let Some(first) = points.first() {
-            let around = Around::new(first.frame, self.half);
+        let rejected = self.pending_rejected.pop_front().unwrap_or_default();
+        if let Some(frame) = points.first().or(rejected.first()).map(|p| p.frame) {
+            let around = Around::new(frame, self.half);
             self.find_tracks(&points);
             let noise = self.noise_variance(&around);
+            if self.restore && !rejected.is_empty() {
+                self.restore(&around, noise, rejected, &mut points);
+            }
             let per_time = 1.0 / self.dt;
             let (ring, slots, tracks_of) = (self.ring(), &self.slots, &self.tracks_of);
             points
@@ -452,6 +517,37 @@ impl VelocitySmoother {
         points.clear();
         self.spare.push(points);
         Ok(())
+    }
+
+    /// Adds to `points` (a frame's emitted points, increasing ids; their trajectories found)
+    /// the `rejected` points of the same frame that their trajectories vouch for, with the
+    /// positions' noise variance `noise` around the frame, and finds the trajectories of the
+    /// merged points.
+    fn restore(
+        &mut self,
+        around: &Around,
+        noise: f64,
+        rejected: Vec<TrackPoint>,
+        points: &mut Vec<TrackPoint>,
+    ) {
+        // The fourth difference of a point on a smooth path has the variance 70σ² per axis;
+        // its squared length over both axes is then 70σ²·χ²₂, held to AGREEMENT_SIGMAS² · 2.
+        let limit = AGREEMENT_SIGMAS * AGREEMENT_SIGMAS * 2.0 * FOURTH_DIFFERENCE_VARIANCE * noise;
+        self.find_tracks(&rejected);
+        let (ring, slots) = (self.ring(), &self.slots);
+        let vouched: Vec<TrackPoint> = rejected
+            .into_iter()
+            .zip(&self.tracks_of)
+            .filter(|&(_, &track)| {
+                track.is_some_and(|t| around.vouched_for(&slots[t * ring..(t + 1) * ring], limit))
+            })
+            .map(|(p, _)| p)
+            .collect();
+        if !vouched.is_empty() {
+            let emitted = std::mem::take(points);
+            *points = merge_by_id(emitted, vouched);
+        }
+        self.find_tracks(points);
     }
 
     /// The trajectory of every point of `points` (increasing ids), by one merge.
@@ -496,8 +592,9 @@ impl VelocitySmoother {
         LEAST_NOISE_VARIANCE
     }
 
-    /// Records the positions of `linked` (increasing ids) at `frames`.
-    fn record(&mut self, frames: StepFrames, linked: &[Linked]) {
+    /// Records the positions of `linked` (increasing ids) at `frames`, their points of
+    /// `frames.at` as `kept` or not.
+    fn record(&mut self, frames: StepFrames, linked: &[Linked], kept: bool) {
         let ring = self.ring() as u64;
         let places = [frames.before, frames.at, frames.after].map(|f| (f, (f % ring) as usize));
         let mut cursor = 0;
@@ -513,12 +610,12 @@ impl VelocitySmoother {
                 late.push(l);
                 continue;
             }
-            self.write(cursor, &places, l, frames.after);
+            self.write(cursor, &places, l, frames.after, kept);
         }
         for l in late {
             let at = self.ids.partition_point(|&id| id < l.id);
             self.add_track(at, l.id);
-            self.write(at, &places, l, frames.after);
+            self.write(at, &places, l, frames.after, kept);
         }
     }
 
@@ -536,11 +633,19 @@ impl VelocitySmoother {
         places: &[(FrameIndex, usize); 3],
         linked: &Linked,
         last: FrameIndex,
+        kept: bool,
     ) {
         let ring = self.ring();
         let slots = &mut self.slots[track * ring..(track + 1) * ring];
-        for (&(frame, slot), &pos) in places.iter().zip(&linked.positions) {
-            slots[slot] = Slot { frame, pos };
+        for (i, (&(frame, slot), &pos)) in places.iter().zip(&linked.positions).enumerate() {
+            // The middle point's status is this step's; a neighbour's stays what its own
+            // step recorded.
+            let kept = if i == 1 {
+                kept
+            } else {
+                slots[slot].frame == frame && slots[slot].kept
+            };
+            slots[slot] = Slot { frame, pos, kept };
         }
         self.last_seen[track] = self.last_seen[track].max(last);
     }
@@ -626,14 +731,36 @@ mod tests {
     }
 
     fn run(smoother: &mut VelocitySmoother, frames: &[Vec<Entry>]) -> Vec<TrackPoint> {
+        run_rejecting(smoother, frames, |_| false)
+    }
+
+    /// Hands `frames` to `smoother` as the tracker does, the points `rejected` picks as
+    /// rejected by the outlier test (carried), the others as emitted.
+    fn run_rejecting(
+        smoother: &mut VelocitySmoother,
+        frames: &[Vec<Entry>],
+        rejected: impl Fn(&TrackPoint) -> bool,
+    ) -> Vec<TrackPoint> {
         let mut out = Vec::new();
         for frame in frames {
-            let mut batch: Vec<TrackPoint> = frame.iter().map(|(p, _, _)| *p).collect();
-            let linked: Vec<Linked> = frame.iter().map(|(_, l, _)| *l).collect();
+            let (rejects, kept): (Vec<Entry>, Vec<Entry>) =
+                frame.iter().partition(|(p, _, _)| rejected(p));
+            let points = |entries: &[Entry]| entries.iter().map(|(p, _, _)| *p).collect();
+            let links =
+                |entries: &[Entry]| -> Vec<Linked> { entries.iter().map(|(_, l, _)| *l).collect() };
+            let (mut batch, mut candidates): (Vec<TrackPoint>, Vec<TrackPoint>) =
+                (points(&kept), points(&rejects));
             smoother
-                .push(frame[0].2, &mut batch, &[&linked], &mut out)
+                .push(
+                    frame[0].2,
+                    &mut batch,
+                    &mut candidates,
+                    &links(&kept),
+                    &links(&rejects),
+                    &mut out,
+                )
                 .unwrap();
-            assert!(batch.is_empty());
+            assert!(batch.is_empty() && candidates.is_empty());
         }
         smoother.flush(&mut out).unwrap();
         out
@@ -646,7 +773,7 @@ mod tests {
             Point2::new(2.0 + 3.0 * t + 0.25 * t * t, 5.0 - t)
         };
         let frames = by_frame(&[trajectory(4, 1..20, path)]);
-        let out = run(&mut VelocitySmoother::new(7, 1.0), &frames);
+        let out = run(&mut VelocitySmoother::new(7, 1.0, true), &frames);
         assert_eq!(out.len(), 19);
         for (p, f) in out.iter().zip(1..) {
             assert_eq!(p.frame, f);
@@ -681,7 +808,7 @@ mod tests {
     /// The mean of `error` over the points of frames 5–24 of `frames` smoothed over
     /// `window` frames.
     fn mean_error(frames: &[Vec<Entry>], window: usize, error: fn(&TrackPoint) -> f64) -> f64 {
-        let out = run(&mut VelocitySmoother::new(window, 1.0), frames);
+        let out = run(&mut VelocitySmoother::new(window, 1.0, true), frames);
         let inner: Vec<f64> = out
             .iter()
             .filter(|p| (5..25).contains(&p.frame))
@@ -704,7 +831,7 @@ mod tests {
         // mean error √(2/5) = 0.63 times Eq. 6's).
         let frames = by_frame(&noisy_straight_tracks());
         let ends = |window: usize| {
-            let out = run(&mut VelocitySmoother::new(window, 1.0), &frames);
+            let out = run(&mut VelocitySmoother::new(window, 1.0, true), &frames);
             let errors: Vec<f64> = out
                 .iter()
                 .filter(|p| p.frame == 1 || p.frame == 29)
@@ -736,7 +863,7 @@ mod tests {
         };
         let mut tracks = noisy_straight_tracks();
         tracks.push(trajectory(1000, 1..30, circle));
-        let out = run(&mut VelocitySmoother::new(7, 1.0), &by_frame(&tracks));
+        let out = run(&mut VelocitySmoother::new(7, 1.0, true), &by_frame(&tracks));
         let turning: Vec<&TrackPoint> = out.iter().filter(|p| p.track_id == 1000).collect();
         assert_eq!(turning.len(), 29);
         for p in turning {
@@ -767,9 +894,9 @@ mod tests {
         let expected = |g: FrameIndex| back(g).min(ahead(g));
         for g in (1..16).filter(|&g| g != 8) {
             // Record up to frame g + 3 (the last point's `after`), then look around g.
-            let mut smoother = VelocitySmoother::new(7, 1.0);
+            let mut smoother = VelocitySmoother::new(7, 1.0, true);
             for (_, linked, step) in track.iter().filter(|(p, _, _)| p.frame < g + 3) {
-                smoother.record(*step, std::slice::from_ref(linked));
+                smoother.record(*step, std::slice::from_ref(linked), true);
             }
             let around = Around::new(g, 3);
             let reach = (1..=3)
@@ -795,29 +922,89 @@ mod tests {
     }
 
     #[test]
+    fn a_rejected_point_is_written_only_between_kept_ones_on_a_smooth_path() {
+        // Curved paths with 0.05 px of position noise; ids 0-5 set the noise level.
+        let path = |id: TrackId, shift_at_10: f64| {
+            move |f: FrameIndex| {
+                let t = f as f64;
+                let shift = if f == 10 { shift_at_10 } else { 0.0 };
+                Point2::new(
+                    10.0 * id as f64 + 3.0 * t + 0.1 * t * t + jitter(id, f, 0, 0.05) + shift,
+                    2.0 * t + jitter(id, f, 1, 0.05),
+                )
+            }
+        };
+        let mut tracks: Vec<Vec<Entry>> = (0..6)
+            .map(|id| trajectory(id, 1..20, path(id, 0.0)))
+            .collect();
+        // 6: rejected at frame 10 on its path; 7: rejected there 1.5 px off its path (a
+        // wrong point the links run through); 8: rejected at frames 10 and 11.
+        tracks.push(trajectory(6, 1..20, path(6, 0.0)));
+        tracks.push(trajectory(7, 1..20, path(7, 1.5)));
+        tracks.push(trajectory(8, 1..20, path(8, 0.0)));
+        let frames = by_frame(&tracks);
+        let rejected = |p: &TrackPoint| {
+            (p.track_id >= 6 && p.frame == 10) || (p.track_id == 8 && p.frame == 11)
+        };
+        let written = |restore: bool| {
+            let out = run_rejecting(
+                &mut VelocitySmoother::new(7, 1.0, restore),
+                &frames,
+                rejected,
+            );
+            let ids_at = |frame| -> Vec<TrackId> {
+                out.iter()
+                    .filter(|p| p.frame == frame)
+                    .map(|p| p.track_id)
+                    .collect()
+            };
+            (ids_at(10), ids_at(11), out)
+        };
+        let (at_10, at_11, out) = written(true);
+        assert_eq!(
+            at_10,
+            vec![0, 1, 2, 3, 4, 5, 6],
+            "only id 6 restored, in id order"
+        );
+        assert_eq!(at_11, vec![0, 1, 2, 3, 4, 5, 6, 7]);
+        let restored = out
+            .iter()
+            .find(|p| p.track_id == 6 && p.frame == 10)
+            .unwrap();
+        let v = restored.vel_px_per_frame.unwrap();
+        assert!(
+            (v - Vec2::new(5.0, 2.0)).norm() < 0.1,
+            "fitted velocity {v:?}"
+        );
+        let (at_10, at_11, _) = written(false);
+        assert_eq!(at_10, vec![0, 1, 2, 3, 4, 5]);
+        assert_eq!(at_11, vec![0, 1, 2, 3, 4, 5, 6, 7]);
+    }
+
+    #[test]
     fn a_velocity_is_in_px_per_dt_and_three_frames_pass_points_straight_through() {
         let path = |f: FrameIndex| Point2::new(4.0 * f as f64, 0.0);
         let frames = by_frame(&[trajectory(0, 1..10, path)]);
-        let out = run(&mut VelocitySmoother::new(7, 0.5), &frames);
+        let out = run(&mut VelocitySmoother::new(7, 0.5, true), &frames);
         // Fitted: 8 px per unit of time, the first and last points over the frames on their
         // one side (they came with 4, in px per frame).
         assert!(
             out.iter()
                 .all(|p| (p.vel_px_per_frame.unwrap().x - 8.0).abs() < 1e-12)
         );
-        let mut through = VelocitySmoother::new(3, 1.0);
+        let mut through = VelocitySmoother::new(3, 1.0, true);
         let mut out = Vec::new();
         let (point, linked, step) = frames[0][0];
         let mut batch = vec![point];
         through
-            .push(step, &mut batch, &[&[linked]], &mut out)
+            .push(step, &mut batch, &mut Vec::new(), &[linked], &[], &mut out)
             .unwrap();
         assert_eq!(out.len(), 1, "no delay with three frames");
     }
 
     #[test]
     fn trajectories_out_of_reach_are_dropped_and_an_id_seen_again_is_taken_back() {
-        let mut smoother = VelocitySmoother::new(5, 1.0);
+        let mut smoother = VelocitySmoother::new(5, 1.0, true);
         let early = trajectory(3, 1..4, |f| Point2::new(f as f64, 0.0));
         let steady = trajectory(5, 1..40, |f| Point2::new(0.0, 2.0 * f as f64));
         let late = trajectory(3, 30..40, |f| Point2::new(3.0 * f as f64, 0.0));

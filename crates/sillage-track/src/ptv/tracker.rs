@@ -251,6 +251,10 @@ pub struct PtvTracker {
     /// Scratch of the radix sorts of `emit_order` and `carry_order`.
     emit_scratch: Vec<(TrackId, usize)>,
     emitted: Vec<TrackPoint>,
+    /// The rejected tracklets' points that carry an id, in `carry_order`, for the smoother
+    /// to restore where their trajectories vouch for them (`restore_flanked`).
+    #[serde(skip)]
+    rejected: Vec<TrackPoint>,
     /// Fits the emitted points' velocities along their trajectories, holding them until
     /// their windows are complete (absent from older checkpoints: Eq. 6 velocities). Boxed:
     /// its buffers would make the tracker the one large variant of the facade's tracker enum.
@@ -292,7 +296,11 @@ impl PtvTracker {
         params.validate()?;
         let vote = params.vote_search_px;
         let params_warm_up = params.warm_up_frames;
-        let smoother = Box::new(VelocitySmoother::new(params.velocity_window, params.dt));
+        let smoother = Box::new(VelocitySmoother::new(
+            params.velocity_window,
+            params.dt,
+            params.restore_flanked,
+        ));
         Ok(Self {
             field: MotionField::new(params.motion_av, params.filter_time),
             params,
@@ -341,6 +349,7 @@ impl PtvTracker {
             rejected_at: Vec::new(),
             velocity_at: Vec::new(),
             emitted: Vec::new(),
+            rejected: Vec::new(),
             smoother,
             linked: Vec::new(),
             carried: Vec::new(),
@@ -878,23 +887,10 @@ impl PtvTracker {
             }
         }
         sort_by_track_id(&mut self.emit_order, &mut self.emit_scratch);
-        let (triplets, vel_pred, c1, frame) =
-            (&self.triplets, &self.vel_pred, &self.c1, self.frame_c1);
-        self.emit_order
-            .par_iter()
-            .with_min_len(PAR_MIN_LEN)
-            .map(|&(track_id, n)| {
-                let t = &triplets[n];
-                TrackPoint {
-                    vel_px_per_frame: Some(t.vel),
-                    acc_px_per_frame2: Some(t.acc),
-                    vel_pred_px_per_frame: Some(vel_pred[t.middle]),
-                    log10_pred_err: Some(t.log_err),
-                    detection: Some(t.middle as u32),
-                    ..TrackPoint::at(frame, track_id, c1[t.middle])
-                }
-            })
-            .collect_into_vec(&mut self.emitted);
+        let mut emitted = std::mem::take(&mut self.emitted);
+        self.points_of(&self.emit_order, &mut emitted);
+        self.emitted = emitted;
+        let frame = self.frame_c1;
         let frames = StepFrames {
             before: match self.direction {
                 PassDirection::Forward => frame.saturating_sub(self.gap_c1),
@@ -912,13 +908,41 @@ impl PtvTracker {
             self.link(&self.emit_order, &mut linked);
             self.link(&self.carry_order, &mut carried);
             (self.linked, self.carried) = (linked, carried);
+            if self.params.restore_flanked {
+                let mut rejected = std::mem::take(&mut self.rejected);
+                self.points_of(&self.carry_order, &mut rejected);
+                self.rejected = rejected;
+            }
         }
         self.smoother.push(
             frames,
             &mut self.emitted,
-            &[&self.linked, &self.carried],
+            &mut self.rejected,
+            &self.linked,
+            &self.carried,
             sink,
         )
+    }
+
+    /// The track points (frame t−1) of the tracklets `order` names, into `points`.
+    fn points_of(&self, order: &[(TrackId, usize)], points: &mut Vec<TrackPoint>) {
+        let (triplets, vel_pred, c1, frame) =
+            (&self.triplets, &self.vel_pred, &self.c1, self.frame_c1);
+        order
+            .par_iter()
+            .with_min_len(PAR_MIN_LEN)
+            .map(|&(track_id, n)| {
+                let t = &triplets[n];
+                TrackPoint {
+                    vel_px_per_frame: Some(t.vel),
+                    acc_px_per_frame2: Some(t.acc),
+                    vel_pred_px_per_frame: Some(vel_pred[t.middle]),
+                    log10_pred_err: Some(t.log_err),
+                    detection: Some(t.middle as u32),
+                    ..TrackPoint::at(frame, track_id, c1[t.middle])
+                }
+            })
+            .collect_into_vec(points);
     }
 
     /// The three positions (frames t−2, t−1, t) of the tracklets `order` names, for the
