@@ -150,8 +150,12 @@ pub fn run(args: &PtvArgs) -> Result<()> {
         };
         println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
+        let restored = summary
+            .restored_points
+            .filter(|&n| n > 0)
+            .map_or(String::new(), |n| format!(" ({n} restored)"));
         eprintln!(
-            "{} frames, {} detections, {} track points in {} tracks → {} ({:.2} ms/frame detection, {:.2} ms/frame tracking)",
+            "{} frames, {} detections, {} track points{restored} in {} tracks → {} ({:.2} ms/frame detection, {:.2} ms/frame tracking)",
             summary.frames,
             summary.detections,
             summary.points,

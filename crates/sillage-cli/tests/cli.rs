@@ -94,6 +94,11 @@ fn synth_track_and_eval_round_trip() {
         .as_f64()
         .expect("the measured source density in --json");
     assert!(density > 0.0 && density < 0.1, "source density {density}");
+    // The points written because their trajectories vouch for them are counted among all.
+    let restored = summary["restored_points"]
+        .as_u64()
+        .expect("the restored points in --json");
+    assert!(restored <= summary["points"].as_u64().unwrap(), "{summary}");
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
     let text = fs::read_to_string(&tracks).unwrap();
     let header: Vec<&str> = text.lines().take(3).collect();

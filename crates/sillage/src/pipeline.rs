@@ -117,6 +117,10 @@ pub struct RunSummary {
     pub vote_valid_share: Option<f64>,
     /// PTV: displacement voting's search radius in use at the end of the run (`None`: off).
     pub vote_search_px: Option<f64>,
+    /// PTV: the points among `points` that the outlier test rejected and that were written
+    /// because their trajectories vouch for them (`tracker.restore_flanked`); `None` for
+    /// other trackers.
+    pub restored_points: Option<u64>,
 }
 
 /// Wall time spent per stage over the frames of a run.
@@ -449,6 +453,7 @@ impl Pipeline {
             totals.measured_displacement_px = tracker.measured_displacement();
             totals.vote_valid_share = tracker.measured_vote_valid_share();
             totals.vote_search_px = tracker.vote_radius();
+            totals.restored_points = Some(tracker.restored_points());
         }
         if timings.frames > 0 {
             let per_frame = |d: Duration| d.as_secs_f64() * 1e3 / timings.frames as f64;

@@ -381,6 +381,9 @@ pub(crate) struct VelocitySmoother {
     /// (increasing ids), candidates for [`Self::restore`].
     #[serde(default)]
     pending_rejected: VecDeque<Vec<TrackPoint>>,
+    /// Rejected points emitted in this pass because their trajectories vouched for them.
+    #[serde(default)]
+    restored: u64,
     /// Emptied batches, reused.
     #[serde(skip)]
     spare: Vec<Vec<TrackPoint>>,
@@ -418,10 +421,17 @@ impl VelocitySmoother {
         self.active = active;
         self.pending.clear();
         self.pending_rejected.clear();
+        self.restored = 0;
         self.ids.clear();
         self.last_seen.clear();
         self.slots.clear();
         self.since_pruned = 0;
+    }
+
+    /// How many rejected points this pass has emitted because their trajectories vouched
+    /// for them.
+    pub fn restored(&self) -> u64 {
+        self.restored
     }
 
     /// Whether points go straight to the sink with their Eq. 6 and 7 kinematics.
@@ -544,6 +554,7 @@ impl VelocitySmoother {
             .map(|(p, _)| p)
             .collect();
         if !vouched.is_empty() {
+            self.restored += vouched.len() as u64;
             let emitted = std::mem::take(points);
             *points = merge_by_id(emitted, vouched);
         }

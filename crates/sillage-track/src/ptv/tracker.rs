@@ -361,6 +361,12 @@ impl PtvTracker {
         })
     }
 
+    /// How many points the outlier test rejected were written in this pass because their
+    /// trajectories vouch for them ([`PtvParams::restore_flanked`]).
+    pub fn restored_points(&self) -> u64 {
+        self.smoother.restored()
+    }
+
     /// The parameters in use.
     pub fn params(&self) -> &PtvParams {
         &self.params
