@@ -58,19 +58,35 @@ fn ptv_rows_of_a_synthetic_vortex_are_unchanged() {
     // the automatic vote widened by where its displacements land; on 2026-12-01 the pair
     // fits started as far apart as the window's spread says (`PAIR_START_SIGMAS`), and later
     // that day points the outlier test rejected were written where their trajectories vouch
-    // for them (`tracker.restore_flanked`); without it, the rows of before, row for row.
-    let expected = [
-        ("tracks_track.txt", 0xe6cc_353e_1b5d_4b67_u64, ""),
-        ("tracks.csv", 0xa832_9836_3bdf_445a, ""),
-        ("unrestored_track.txt", 0xde03_252b_f063_acef, "false"),
-        ("unrestored.csv", 0x90ef_499c_4a1c_30df, "false"),
+    // for them (`tracker.restore_flanked`), and predictions blended with each trajectory's
+    // last displacement (`tracker.own_motion`); without each, the rows of before, row for row.
+    let own_off = "tracker.own_motion=false";
+    let restore_off = "tracker.restore_flanked=false";
+    let expected: [(&str, u64, &[&str]); 6] = [
+        ("tracks_track.txt", 0x1dfa_9f4d_c528_c680, &[]),
+        ("tracks.csv", 0x212c_72cd_5134_8f5c, &[]),
+        (
+            "model_only_track.txt",
+            0xe6cc_353e_1b5d_4b67_u64,
+            &[own_off],
+        ),
+        ("model_only.csv", 0xa832_9836_3bdf_445a, &[own_off]),
+        (
+            "unrestored_track.txt",
+            0xde03_252b_f063_acef,
+            &[own_off, restore_off],
+        ),
+        (
+            "unrestored.csv",
+            0x90ef_499c_4a1c_30df,
+            &[own_off, restore_off],
+        ),
     ];
-    for (name, hash, restore) in expected {
+    for (name, hash, sets) in expected {
         let out = dir.path().join(name);
         let mut args = vec!["ptv", path_str(&frames), "--out", path_str(&out)];
-        let set = format!("tracker.restore_flanked={restore}");
-        if !restore.is_empty() {
-            args.extend(["--set", &set]);
+        for set in sets {
+            args.extend(["--set", set]);
         }
         run_ok(&args);
         assert_rows(&out, hash, name);

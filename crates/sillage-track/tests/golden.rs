@@ -107,6 +107,7 @@ fn output_on_fixed_scenes_is_unchanged() {
         velocity_window: 3,
         warm_up_frames: 0,
         restore_flanked: false,
+        own_motion: false,
         ..Default::default()
     };
     let default = track(&frames, tractrac.clone(), 1);
@@ -129,6 +130,17 @@ fn output_on_fixed_scenes_is_unchanged() {
         },
         1,
     );
+    // And the predictions blended with each trajectory's last displacement.
+    let own_motion = track(
+        &frames,
+        PtvParams {
+            velocity_window: PtvParams::default().velocity_window,
+            restore_flanked: true,
+            own_motion: true,
+            ..tractrac.clone()
+        },
+        1,
+    );
     let iterated = track(
         &frames,
         PtvParams {
@@ -145,6 +157,7 @@ fn output_on_fixed_scenes_is_unchanged() {
         (iterated.len(), fingerprint(&iterated)),
         (fitted.len(), fingerprint(&fitted)),
         (restored.len(), fingerprint(&restored)),
+        (own_motion.len(), fingerprint(&own_motion)),
     ];
     println!("{got:?}");
     assert!(default.len() > 100_000);
@@ -162,10 +175,12 @@ fn output_on_fixed_scenes_is_unchanged() {
 /// less than 0.1 px stopped being an outlier (`SURE_LINK_LOG_ERR`; these detections are
 /// exact, so such links are right): 116,883 → 116,898 and 116,093 → 116,523 points. The
 /// fourth, with the rejected points a trajectory vouches for written (`restore_flanked`),
-/// added on 2026-12-01 with that parameter.
-const EXPECTED: [(usize, u64); 4] = [
+/// added on 2026-12-01 with that parameter; the fifth, with the predictions blended with each
+/// trajectory's last displacement (`own_motion`), the same day.
+const EXPECTED: [(usize, u64); 5] = [
     (116_898, 7_732_528_358_411_815_209),
     (116_523, 13_837_768_037_016_009_985),
     (116_898, 13_913_804_998_168_621_735),
     (117_034, 14_047_780_696_869_507_909),
+    (117_031, 9_140_180_764_466_646_217),
 ];

@@ -777,3 +777,65 @@ fn a_warm_up_links_the_first_frames_with_the_flow_it_learned() {
     let trained = scene.feed(&mut tracker, PassDirection::Forward);
     assert_eq!(trained, scene.track(params(0)));
 }
+
+/// A Taylor–Green cellular flow, cells `cell` px wide and up to `speed` px/frame: the
+/// position at time `t` of the particle starting at `p` (fourth-order Runge–Kutta, 20 steps
+/// per frame).
+fn cellular_path(cell: f64, speed: f64) -> impl Fn(Point2, f64) -> Point2 {
+    let k = std::f64::consts::PI / cell;
+    let velocity = move |p: Point2| {
+        Vec2::new(
+            speed * (k * p.x).sin() * (k * p.y).cos(),
+            -speed * (k * p.x).cos() * (k * p.y).sin(),
+        )
+    };
+    move |p0: Point2, t: f64| {
+        let steps = (20.0 * t).round() as usize;
+        let h = 1.0 / 20.0;
+        let mut p = p0;
+        for _ in 0..steps {
+            let k1 = velocity(p);
+            let k2 = velocity(p + k1 * (h / 2.0));
+            let k3 = velocity(p + k2 * (h / 2.0));
+            let k4 = velocity(p + k3 * h);
+            p = p + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
+        }
+        p
+    }
+}
+
+#[test]
+fn predictions_that_follow_the_trajectory_track_small_vortex_cells() {
+    // 800 particles 10 px apart in cells 40 px wide turning at up to 4 px per frame: the
+    // model's ten neighbours reach across a good part of a cell, whose flow turns within it.
+    let scene = Scene::new(
+        3,
+        800,
+        20,
+        jittered_lattice(10.0),
+        cellular_path(40.0, 4.0),
+        1.0,
+        0,
+    );
+    let track = |own_motion: bool| {
+        scene.link_scores(&scene.track(PtvParams {
+            own_motion,
+            ..PtvParams::default()
+        }))
+    };
+    let (model_recall, model_precision) = track(false);
+    let (own_recall, own_precision) = track(true);
+    eprintln!(
+        "model alone: recall {model_recall:.3}, precision {model_precision:.4}; \
+         with the trajectories: {own_recall:.3}, {own_precision:.4}"
+    );
+    // A quarter fewer links missed (measured: 0.924 → 0.949), none more wrong.
+    assert!(
+        1.0 - own_recall < 0.75 * (1.0 - model_recall),
+        "{own_recall} vs {model_recall}"
+    );
+    assert!(
+        own_precision >= model_precision,
+        "{own_precision} vs {model_precision}"
+    );
+}

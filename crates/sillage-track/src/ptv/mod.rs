@@ -3,7 +3,9 @@
 //! At each new frame t, [`PtvTracker`]:
 //! 1. predicts where the points of frame t−1 go, `x + U·dt`, with a motion model averaged
 //!    over the k nearest velocity samples (Eqs. 8–9; `U = 0` until two samples exist),
-//!    optionally corrected by displacement voting (`vote_search_px`, see `voting`);
+//!    optionally corrected by displacement voting (`vote_search_px`, see `voting`), and
+//!    blended with each trajectory's own last displacement where that errs less
+//!    (`own_motion`);
 //! 2. keeps the mutual nearest-neighbour pairs between the predictions and frame t;
 //! 3. makes a tracklet of every point of frame t−1 paired both backwards (t−2 ↔ t−1) and
 //!    forwards (t−1 ↔ t), with central-difference kinematics (Eqs. 6–7);
@@ -28,8 +30,8 @@ mod voting;
 
 pub use params::{
     AUTO_VOTE_FIRST_LINK_SPACINGS, AUTO_VOTE_MARGIN, AUTO_VOTE_MIN_VALID_SHARE, AUTO_VOTE_SPACINGS,
-    AUTO_VOTE_UNRESOLVED_SPACINGS, DEFAULT_RESTORE_FLANKED, DEFAULT_VELOCITY_WINDOW,
-    DEFAULT_WARM_UP_FRAMES, MAX_VELOCITY_WINDOW, MAX_WARM_UP_FRAMES, PtvParams, VoteMode,
-    VoteSearch,
+    AUTO_VOTE_UNRESOLVED_SPACINGS, DEFAULT_OWN_MOTION, DEFAULT_RESTORE_FLANKED,
+    DEFAULT_VELOCITY_WINDOW, DEFAULT_WARM_UP_FRAMES, MAX_VELOCITY_WINDOW, MAX_WARM_UP_FRAMES,
+    PtvParams, VoteMode, VoteSearch,
 };
 pub use tracker::{PassDirection, PtvTracker};

@@ -195,6 +195,13 @@ pub struct PtvTracker {
     index_pred: PointIndex,
     /// Per point of `c1`: its mutual partner in `c0`.
     link01: Vec<Option<usize>>,
+    /// Per point of `c1`: the acceleration of the tracklet of the previous step that ended
+    /// on it (its trajectory's at t−2), for [`PtvParams::own_motion`]; and per point of `c2`,
+    /// this step's, rotated in by [`PtvTracker::shift`] (absent from older checkpoints).
+    #[serde(default)]
+    back_acc: Vec<Option<Vec2>>,
+    #[serde(default)]
+    ahead_acc: Vec<Option<Vec2>>,
     /// Per point of `c0`: the track id its tracklet handed over.
     ids0: Vec<Option<TrackId>>,
     next_id: TrackId,
@@ -315,6 +322,8 @@ impl PtvTracker {
             index_c2: PointIndex::default(),
             index_pred: PointIndex::default(),
             link01: Vec::new(),
+            back_acc: Vec::new(),
+            ahead_acc: Vec::new(),
             ids0: Vec::new(),
             next_id: 0,
             recent: Samples::default(),
@@ -499,6 +508,42 @@ impl PtvTracker {
                 .zip(&self.vel_pred)
                 .map(|(&p, &u)| p + u * dt),
         );
+        // The links back to frame t−2 and their accelerations are this pass's from the
+        // second full step on.
+        if self.params.own_motion && model_applied && self.frames_in_pass >= 2 {
+            self.blend_own_motion(dt);
+        }
+    }
+
+    /// [`PtvParams::own_motion`]: moves each prediction of a point linked back to frame t−2
+    /// towards `x + d_own`, its last displacement scaled to this link's `dt`, by the
+    /// inverse-variance weight of the two predictions' expected errors.
+    fn blend_own_motion(&mut self, dt: f64) {
+        let one_frame = self.signed_dt();
+        let scale = dt / (one_frame * self.gap_c1 as f64);
+        // The model's errors ε̄ were measured over one frame (`make_tracklets`).
+        let model_frames = dt / one_frame;
+        let (c0, c1, vel_pred) = (&self.c0, &self.c1, &self.vel_pred);
+        let (log_err_pred, back_acc) = (&self.log_err_pred, &self.back_acc);
+        self.pred
+            .par_iter_mut()
+            .zip(&self.link01)
+            .enumerate()
+            .with_min_len(PAR_MIN_LEN)
+            .for_each(|(j, (pred, back))| {
+                let (Some(i), Some(Some(acc))) = (*back, back_acc.get(j)) else {
+                    return;
+                };
+                let own = (c1[j] - c0[i]) * scale;
+                let model = vel_pred[j] * dt;
+                let own_err = acc.max_abs() * dt * dt;
+                let model_err = 10f64.powf(log_err_pred[j]) * model_frames;
+                let total = own_err * own_err + model_err * model_err;
+                if total > 0.0 {
+                    let w = model_err * model_err / total;
+                    *pred = c1[j] + own * w + model * (1.0 - w);
+                }
+            });
     }
 
     /// The automatic voting decision ([`VoteSearch::AUTO`]) on the first two frames: a vote
@@ -976,6 +1021,7 @@ impl PtvTracker {
         std::mem::swap(&mut self.c1, &mut self.c2);
         std::mem::swap(&mut self.index_c1, &mut self.index_c2);
         std::mem::swap(&mut self.link01, &mut self.link21);
+        std::mem::swap(&mut self.back_acc, &mut self.ahead_acc);
         std::mem::swap(&mut self.ids0, &mut self.ids1);
         self.frame_c1 = frame;
     }
@@ -1076,6 +1122,8 @@ impl PtvTracker {
                 self.associate(applied);
                 self.ids1.clear();
                 self.ids1.resize(self.c1.len(), None);
+                self.ahead_acc.clear();
+                self.ahead_acc.resize(self.c2.len(), None);
                 self.shift(obs.frame, gap);
             }
             _ => {
@@ -1100,6 +1148,11 @@ impl PtvTracker {
                 }
                 if model_updated {
                     std::mem::swap(&mut self.stored, &mut self.next_stored);
+                }
+                self.ahead_acc.clear();
+                self.ahead_acc.resize(self.c2.len(), None);
+                for t in &self.triplets {
+                    self.ahead_acc[t.after] = Some(t.acc);
                 }
                 self.hand_over_ids(obs.frame, sink)?;
                 std::mem::swap(&mut self.recent, &mut self.current);
