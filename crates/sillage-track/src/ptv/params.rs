@@ -86,8 +86,8 @@ pub struct PtvParams {
 }
 
 /// The default [`PtvParams::own_motion`]. Chosen on the tune halves of both accuracy
-/// families among four forms (mean true / false recoveries %, main then moderate): the
-/// model alone 66.36 / 13.37 and 90.40 / 2.28; the trajectory's displacement alone 66.10 /
+/// families among four forms against the model alone (mean true / false recoveries %, main
+/// then moderate): the model alone 66.36 / 13.37 and 90.40 / 2.28; the trajectory's displacement alone 66.10 /
 /// 13.23 and 90.73 / 1.91; their mean 66.25 / 13.27 and 90.83 / 2.05; the one of smaller
 /// expected error 66.43 / 13.34 and 90.93 / 2.11; the inverse-variance blend 66.40 / 13.34
 /// and 90.96 / 2.12 (no weight to tune). On the report halves, never used to choose: main
