@@ -24,10 +24,12 @@ import sillage
 DATA = pathlib.Path(__file__).resolve().parents[2] / "shared" / "data" / "trackpy_bulk_water" / "frames"
 
 
-def matched(reference, found, radius=1.5):
-    """Number of `reference` points with a one-to-one partner in `found` within `radius`."""
+def matched_flags(reference, found, radius=1.5):
+    """Per `reference` point, whether it has a one-to-one partner in `found` within `radius`
+    (nearest first, by the Hungarian algorithm on the distances)."""
+    flags = np.zeros(len(reference), dtype=bool)
     if len(reference) == 0 or len(found) == 0:
-        return 0
+        return flags
     tree = cKDTree(found)
     pairs = tree.query_ball_point(reference, radius)
     cost = np.full((len(reference), len(found)), 1e6)
@@ -35,17 +37,33 @@ def matched(reference, found, radius=1.5):
         for j in js:
             cost[i, j] = np.hypot(*(reference[i] - found[j]))
     rows, cols = linear_sum_assignment(cost)
-    return int(np.sum(cost[rows, cols] < radius))
+    flags[rows[cost[rows, cols] < radius]] = True
+    return flags
+
+
+def matched(reference, found, radius=1.5):
+    """Number of `reference` points with a one-to-one partner in `found` within `radius`."""
+    return int(matched_flags(reference, found, radius).sum())
+
+
+def load_frames(count):
+    """The movie's first `count` frames as one uint8 array (frames, rows, columns)."""
+    files = sorted(glob.glob(str(DATA / "*.png")))[:count]
+    return np.array([np.asarray(Image.open(f).convert("L")) for f in files])
+
+
+def trackpy_features(frames):
+    """trackpy's features as its walkthrough finds them."""
+    trackpy.quiet()
+    return trackpy.batch(frames, 11, invert=True, minmass=20, processes=1)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=10)
     args = parser.parse_args()
-    files = sorted(glob.glob(str(DATA / "*.png")))[: args.frames]
-    frames = np.array([np.asarray(Image.open(f).convert("L")) for f in files])
-    trackpy.quiet()
-    reference = trackpy.batch(frames, 11, invert=True, minmass=20, processes=1)
+    frames = load_frames(args.frames)
+    reference = trackpy_features(frames)
     settings = {"defaults": {}}
     for k in (3.0, 2.0):
         settings[f"defaults, threshold.noise.k={k:g}"] = {"threshold": {"noise": {"k": k}}}
