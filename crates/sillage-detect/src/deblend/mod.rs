@@ -108,21 +108,10 @@ pub(crate) struct Deblender {
     /// Re-fit the crowded detections after the splits.
     refit: bool,
     half_width: usize,
-    /// Per detection of the frame: its screen if it is a flat peak, its residual variance if
-    /// it is a sampled round one (reused between frames).
-    screens: Vec<(Option<Screen>, Option<f64>)>,
-    /// The sampled round peaks' residual variances (reused).
+    /// The sampled round peaks' residual variances (reused between frames).
     variances: Vec<f64>,
     /// The detections bucketed in cells as wide as the reach of a neighbour.
     grid: CellGrid,
-}
-
-/// What the screen of one detection found: the squared residual of one particle of the
-/// measured σ at the detection, and its degrees of freedom.
-#[derive(Debug, Clone, Copy)]
-struct Screen {
-    residual: f64,
-    dof: usize,
 }
 
 /// Buffers of one rayon task: the examined detection then its neighbours, the window's
@@ -145,7 +134,6 @@ impl Deblender {
             sigma_px,
             refit: refit_crowded,
             half_width: (WINDOW_SIGMAS * sigma_px).ceil().max(2.0) as usize,
-            screens: Vec::new(),
             variances: Vec::new(),
             grid: CellGrid::default(),
         }
@@ -165,95 +153,106 @@ impl Deblender {
     ) {
         self.grid
             .rebuild(input.dimensions(), detections, offset, self.reach());
-        let mut screens = std::mem::take(&mut self.screens);
-        let mut variances = std::mem::take(&mut self.variances);
-        let this = &*self;
-        let found: &[Detection] = detections;
-        let local = |i: usize| local_position(found, offset, i);
-        let gather = |centres: &mut Vec<Point2>, i: usize| this.gather(found, offset, i, centres);
-        // Flat peaks are screened; so is a sample of the round ones (every `stride`-th
-        // detection), whose residuals, mostly single particles', measure the noise.
-        let stride = (found.len() / NOISE_SAMPLE).max(1);
-        (0..found.len())
+        let flat: Vec<bool> = (0..detections.len())
             .into_par_iter()
             .with_min_len(PAR_MIN_LEN)
+            .map(|i| is_flat(matched, local_position(detections, offset, i)))
+            .collect();
+        let Some(noise) = self.noise(input, sign, offset, detections, &flat) else {
+            return;
+        };
+        let this = &*self;
+        let found: &[Detection] = detections;
+        // Each flat peak is screened: where one particle of the measured σ, its neighbours
+        // fitted beside it, leaves more than `SPLIT_CHI2` noise variances above its degrees of
+        // freedom, the neighbours are subtracted with the screen's amplitudes and the pair is
+        // fitted.
+        let pairs: Vec<(usize, [Point2; 2])> = (0..found.len())
+            .into_par_iter()
+            .with_min_len(PAR_MIN_LEN)
+            .filter(|&i| flat[i])
             .map_init(Scratch::default, |scratch, i| {
-                let flat = is_flat(matched, local(i));
-                if !flat && i % stride != 0 {
-                    return (None, None);
-                }
                 let Scratch {
                     centres,
                     values,
+                    cleaned,
+                    sorted,
                     profiles,
-                    ..
                 } = scratch;
-                if !gather(centres, i) {
-                    return (None, None);
+                if !this.gather(found, offset, i, centres) {
+                    return None;
                 }
-                let Some(window) = Window::around(input, sign, local(i), this.half_width, values)
-                else {
-                    return (None, None);
-                };
-                let Some((residual, _)) = linear_fit(&window, centres, this.sigma_px, profiles)
-                else {
-                    return (None, None);
-                };
+                let p = centres[0];
+                let window = Window::around(input, sign, p, this.half_width, values)?;
+                let (residual, amplitudes) = linear_fit(&window, centres, this.sigma_px, profiles)?;
                 let dof = window.len().saturating_sub(1 + centres.len()).max(1);
-                let screen = flat.then_some(Screen { residual, dof });
-                (screen, (!flat).then_some(residual / dof as f64))
+                if residual - dof as f64 * noise <= SPLIT_CHI2 * noise {
+                    return None;
+                }
+                let clean =
+                    window.with_neighbours_subtracted(centres, &amplitudes, cleaned, profiles);
+                let pair = this.fit_pair(&clean, &centres[1..], p, noise, sorted, profiles)?;
+                Some((i, pair))
             })
-            .collect_into_vec(&mut screens);
-        variances.clear();
-        variances.extend(
-            screens
-                .iter()
-                .filter_map(|&(_, v)| v.filter(|v| v.is_finite())),
-        );
-        if variances.len() >= MIN_SCREENS {
-            let mid = variances.len() / 2;
-            let noise = *variances.select_nth_unstable_by(mid, f64::total_cmp).1;
-            if noise > 0.0 {
-                let pairs: Vec<(usize, [Point2; 2])> = screens
-                    .par_iter()
-                    .enumerate()
-                    .with_min_len(PAR_MIN_LEN)
-                    .filter(|(_, (screen, _))| {
-                        screen
-                            .is_some_and(|s| s.residual - s.dof as f64 * noise > SPLIT_CHI2 * noise)
-                    })
-                    .map_init(Scratch::default, |scratch, (i, _)| {
-                        let Scratch {
-                            centres,
-                            values,
-                            cleaned,
-                            sorted,
-                            profiles,
-                        } = scratch;
-                        gather(centres, i);
-                        let p = local(i);
-                        let window = Window::around(input, sign, p, this.half_width, values)?;
-                        let clean =
-                            window.without_neighbours(centres, this.sigma_px, cleaned, profiles)?;
-                        let pair =
-                            this.fit_pair(&clean, &centres[1..], p, noise, sorted, profiles)?;
-                        Some((i, pair))
-                    })
-                    .flatten()
-                    .collect();
-                for (i, [a, b]) in pairs {
-                    let strength = detections[i].strength;
-                    let at = |p: Point2| Point2::new(p.x + offset.0, p.y + offset.1);
-                    detections[i].pos_px = at(a);
-                    detections.push(Detection::new(at(b), strength));
-                }
-                if self.refit {
-                    self.refit_crowded(input, sign, offset, detections, noise);
-                }
-            }
+            .flatten()
+            .collect();
+        for (i, [a, b]) in pairs {
+            let strength = detections[i].strength;
+            let at = |p: Point2| Point2::new(p.x + offset.0, p.y + offset.1);
+            detections[i].pos_px = at(a);
+            detections.push(Detection::new(at(b), strength));
         }
-        self.screens = screens;
+        if self.refit {
+            self.refit_crowded(input, sign, offset, detections, noise);
+        }
+    }
+
+    /// The frame's noise variance: the median residual variance of the screens of a sample
+    /// of its round peaks (every `n / NOISE_SAMPLE`-th detection that is not `flat`), mostly
+    /// single particles; `None` when fewer than [`MIN_SCREENS`] could be screened or it is
+    /// not positive.
+    fn noise(
+        &mut self,
+        input: &GrayImage,
+        sign: f64,
+        offset: (f64, f64),
+        found: &[Detection],
+        flat: &[bool],
+    ) -> Option<f64> {
+        let stride = (found.len() / NOISE_SAMPLE).max(1);
+        let mut variances = std::mem::take(&mut self.variances);
+        let this = &*self;
+        variances.clear();
+        variances.par_extend(
+            (0..found.len())
+                .into_par_iter()
+                .step_by(stride)
+                .filter(|&i| !flat[i])
+                .map_init(Scratch::default, |scratch, i| {
+                    let Scratch {
+                        centres,
+                        values,
+                        profiles,
+                        ..
+                    } = scratch;
+                    if !this.gather(found, offset, i, centres) {
+                        return None;
+                    }
+                    let window = Window::around(input, sign, centres[0], this.half_width, values)?;
+                    let (residual, _) = linear_fit(&window, centres, this.sigma_px, profiles)?;
+                    let dof = window.len().saturating_sub(1 + centres.len()).max(1);
+                    Some(residual / dof as f64).filter(|v| v.is_finite())
+                })
+                .flatten(),
+        );
+        let noise = (variances.len() >= MIN_SCREENS)
+            .then(|| {
+                let mid = variances.len() / 2;
+                *variances.select_nth_unstable_by(mid, f64::total_cmp).1
+            })
+            .filter(|&noise| noise > 0.0);
         self.variances = variances;
+        noise
     }
 
     /// How far a neighbour may lie to enter a fit: the window's half-width and two σ.

@@ -1,6 +1,6 @@
 //! The square window of the frame a detection is examined in.
 
-use super::model::{Profiles, linear_fit};
+use super::model::{Amplitudes, Profiles, linear_fit};
 use sillage_core::{GrayImage, Point2, Vec2};
 
 /// The pixels of a square window of the frame, particles positive, and their sum of squares.
@@ -54,9 +54,9 @@ impl<'v> Window<'v> {
         self.values.len()
     }
 
-    /// This window with the particles at `others` subtracted: Gaussians of std `sigma` with
-    /// the amplitudes of the linear fit of a background and particles at `p` and `others`
-    /// (stored in `cleaned`); `None` when that fit is singular.
+    /// This window with the particles at `centres[1..]` subtracted: Gaussians of std `sigma`
+    /// with the amplitudes of the linear fit of a background and particles at `centres` (the
+    /// examined one first; stored in `cleaned`); `None` when that fit is singular.
     pub(super) fn without_neighbours<'c>(
         &self,
         centres: &[Point2],
@@ -64,14 +64,27 @@ impl<'v> Window<'v> {
         cleaned: &'c mut Vec<f64>,
         profiles: &mut Profiles,
     ) -> Option<Window<'c>> {
-        let (_, solution) = linear_fit(self, centres, sigma, profiles)?;
+        let (_, amplitudes) = linear_fit(self, centres, sigma, profiles)?;
+        Some(self.with_neighbours_subtracted(centres, &amplitudes, cleaned, profiles))
+    }
+
+    /// This window with the particles at `centres[1..]` subtracted, with the `amplitudes`
+    /// (background, then one per centre) of the linear fit that left their Gaussians in
+    /// `profiles` (stored in `cleaned`).
+    pub(super) fn with_neighbours_subtracted<'c>(
+        &self,
+        centres: &[Point2],
+        amplitudes: &Amplitudes,
+        cleaned: &'c mut Vec<f64>,
+        profiles: &Profiles,
+    ) -> Window<'c> {
         let side = self.side;
         cleaned.clear();
         cleaned.extend_from_slice(self.values);
         // Component 0 is the examined particle; the neighbours follow, amplitudes after the
         // background and the particle's.
         for c in 1..centres.len() {
-            let amplitude = solution[1 + c];
+            let amplitude = amplitudes[1 + c];
             let (gx, gy) = profiles.gaussian(c);
             for (row, &fy) in cleaned.chunks_exact_mut(side).zip(gy) {
                 for (v, &fx) in row.iter_mut().zip(gx) {
@@ -79,13 +92,13 @@ impl<'v> Window<'v> {
                 }
             }
         }
-        Some(Window {
+        Window {
             x0: self.x0,
             y0: self.y0,
             side,
             sum_sq: sum_of_squares(cleaned),
             values: cleaned,
-        })
+        }
     }
 
     /// How the window's signal above its median spreads about `p`: the major axis of its
