@@ -270,13 +270,14 @@ impl Deblender {
         centres: &mut Vec<Point2>,
     ) -> bool {
         let p = local_position(found, offset, i);
-        let reach = self.reach();
+        // Squared distances: no square root per candidate.
+        let reach2 = self.reach().powi(2);
         centres.clear();
         centres.push(p);
         let near = self.grid.near(found[i].pos_px).filter(|&j| j != i);
         centres.extend(
             near.map(|j| local_position(found, offset, j))
-                .filter(|q| q.distance(p) < reach),
+                .filter(|&q| (q - p).norm_squared() < reach2),
         );
         centres.len() <= 1 + MAX_NEIGHBOURS
     }
@@ -300,7 +301,7 @@ impl Deblender {
         let this = &*self;
         let found: &[Detection] = detections;
         let sigma = this.sigma_px;
-        let crowded_px = CROWDED_SIGMAS * sigma;
+        let crowded2 = (CROWDED_SIGMAS * sigma).powi(2);
         let moved: Vec<(usize, Point2)> = (0..found.len())
             .into_par_iter()
             .with_min_len(PAR_MIN_LEN)
@@ -316,7 +317,10 @@ impl Deblender {
                     return None;
                 }
                 let p = centres[0];
-                if centres[1..].iter().all(|q| q.distance(p) >= crowded_px) {
+                if centres[1..]
+                    .iter()
+                    .all(|&q| (q - p).norm_squared() >= crowded2)
+                {
                     return None;
                 }
                 let window = Window::around(input, sign, p, this.half_width, values)?;
