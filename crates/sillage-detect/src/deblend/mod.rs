@@ -27,7 +27,7 @@ mod model;
 mod window;
 
 use crate::cell_grid::CellGrid;
-use model::{Profiles, fit, linear_fit};
+use model::{Amplitudes, Profiles, fit, linear_fit};
 use rayon::prelude::*;
 use sillage_core::{Detection, GrayImage, Point2};
 use window::Window;
@@ -126,6 +126,16 @@ struct Scratch {
     profiles: Profiles,
 }
 
+/// What the screen of one detection found ([`Deblender::screen`]): its window, the squared
+/// residual of the linear fit there, its amplitudes (background, then one per centre) and
+/// its degrees of freedom.
+struct Screen<'v> {
+    window: Window<'v>,
+    residual: f64,
+    amplitudes: Amplitudes,
+    dof: usize,
+}
+
 impl Deblender {
     /// A splitter for particle images of std `sigma_px`, which re-fits the crowded detections
     /// too with `refit_crowded`.
@@ -179,19 +189,19 @@ impl Deblender {
                     sorted,
                     profiles,
                 } = scratch;
-                if !this.gather(found, offset, i, centres) {
+                let screen =
+                    this.screen(input, sign, found, offset, i, centres, values, profiles)?;
+                if screen.residual - screen.dof as f64 * noise <= SPLIT_CHI2 * noise {
                     return None;
                 }
-                let p = centres[0];
-                let window = Window::around(input, sign, p, this.half_width, values)?;
-                let (residual, amplitudes) = linear_fit(&window, centres, this.sigma_px, profiles)?;
-                let dof = window.len().saturating_sub(1 + centres.len()).max(1);
-                if residual - dof as f64 * noise <= SPLIT_CHI2 * noise {
-                    return None;
-                }
-                let clean =
-                    window.with_neighbours_subtracted(centres, &amplitudes, cleaned, profiles);
-                let pair = this.fit_pair(&clean, &centres[1..], p, noise, sorted, profiles)?;
+                let clean = screen.window.with_neighbours_subtracted(
+                    centres,
+                    &screen.amplitudes,
+                    cleaned,
+                    profiles,
+                );
+                let pair =
+                    this.fit_pair(&clean, &centres[1..], centres[0], noise, sorted, profiles)?;
                 Some((i, pair))
             })
             .flatten()
@@ -235,13 +245,9 @@ impl Deblender {
                         profiles,
                         ..
                     } = scratch;
-                    if !this.gather(found, offset, i, centres) {
-                        return None;
-                    }
-                    let window = Window::around(input, sign, centres[0], this.half_width, values)?;
-                    let (residual, _) = linear_fit(&window, centres, this.sigma_px, profiles)?;
-                    let dof = window.len().saturating_sub(1 + centres.len()).max(1);
-                    Some(residual / dof as f64).filter(|v| v.is_finite())
+                    let screen =
+                        this.screen(input, sign, found, offset, i, centres, values, profiles)?;
+                    Some(screen.residual / screen.dof as f64).filter(|v| v.is_finite())
                 })
                 .flatten(),
         );
@@ -253,6 +259,36 @@ impl Deblender {
             .filter(|&noise| noise > 0.0);
         self.variances = variances;
         noise
+    }
+
+    /// The screen of detection `i` of `found`: its window of `input` and the linear fit
+    /// there of a background and particles of the measured σ at it and at its neighbours
+    /// (gathered into `centres`, the detection first). `None` when it has more than
+    /// [`MAX_NEIGHBOURS`], its window leaves the frame or the fit is singular.
+    #[allow(clippy::too_many_arguments)]
+    fn screen<'v>(
+        &self,
+        input: &GrayImage,
+        sign: f64,
+        found: &[Detection],
+        offset: (f64, f64),
+        i: usize,
+        centres: &mut Vec<Point2>,
+        values: &'v mut Vec<f64>,
+        profiles: &mut Profiles,
+    ) -> Option<Screen<'v>> {
+        if !self.gather(found, offset, i, centres) {
+            return None;
+        }
+        let window = Window::around(input, sign, centres[0], self.half_width, values)?;
+        let (residual, amplitudes) = linear_fit(&window, centres, self.sigma_px, profiles)?;
+        let dof = window.len().saturating_sub(1 + centres.len()).max(1);
+        Some(Screen {
+            window,
+            residual,
+            amplitudes,
+            dof,
+        })
     }
 
     /// How far a neighbour may lie to enter a fit: the window's half-width and two σ.
