@@ -108,6 +108,8 @@ pub(crate) struct Deblender {
     /// Re-fit the crowded detections after the splits.
     refit: bool,
     half_width: usize,
+    /// Whether each detection of the frame is a flat peak (reused between frames).
+    flat: Vec<bool>,
     /// The sampled round peaks' residual variances (reused between frames).
     variances: Vec<f64>,
     /// The detections bucketed in cells as wide as the reach of a neighbour.
@@ -144,6 +146,7 @@ impl Deblender {
             sigma_px,
             refit: refit_crowded,
             half_width: (WINDOW_SIGMAS * sigma_px).ceil().max(2.0) as usize,
+            flat: Vec::new(),
             variances: Vec::new(),
             grid: CellGrid::default(),
         }
@@ -163,14 +166,31 @@ impl Deblender {
     ) {
         self.grid
             .rebuild(input.dimensions(), detections, offset, self.reach());
-        let flat: Vec<bool> = (0..detections.len())
+        let mut flat = std::mem::take(&mut self.flat);
+        (0..detections.len())
             .into_par_iter()
             .with_min_len(PAR_MIN_LEN)
             .map(|i| is_flat(matched, local_position(detections, offset, i)))
-            .collect();
-        let Some(noise) = self.noise(input, sign, offset, detections, &flat) else {
-            return;
-        };
+            .collect_into_vec(&mut flat);
+        let noise = self.noise(input, sign, offset, detections, &flat);
+        if let Some(noise) = noise {
+            self.split_flat_peaks(input, sign, offset, detections, &flat, noise);
+        }
+        self.flat = flat;
+    }
+
+    /// Screens each `flat` peak of `detections` and splits those that are two particles
+    /// (see [`Deblender::split`]), then re-fits the crowded ones when asked; `noise` is the
+    /// frame's noise variance.
+    fn split_flat_peaks(
+        &mut self,
+        input: &GrayImage,
+        sign: f64,
+        offset: (f64, f64),
+        detections: &mut Vec<Detection>,
+        flat: &[bool],
+        noise: f64,
+    ) {
         let this = &*self;
         let found: &[Detection] = detections;
         // Each flat peak is screened: where one particle of the measured σ, its neighbours
