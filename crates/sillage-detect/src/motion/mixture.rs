@@ -273,13 +273,18 @@ fn is_shadow(background: &[[f32; 3]], value: f32, params: &MixtureParams) -> boo
     })
 }
 
-/// Insertion sort by `w/σ`, largest first (stable: ties keep their order).
+/// Insertion sort by `w/σ`, largest first (stable: ties keep their order). Each Gaussian's
+/// `w/σ` is taken once, not at every comparison.
 fn sort_by_fitness(pixel: &mut [[f32; 3]]) {
-    let fitness = |g: &[f32; 3]| g[0] / g[2].sqrt();
+    let mut fitness = [0f32; MAX_GAUSSIANS];
+    for (f, g) in fitness.iter_mut().zip(pixel.iter()) {
+        *f = g[0] / g[2].sqrt();
+    }
     for i in 1..pixel.len() {
         let mut j = i;
-        while j > 0 && fitness(&pixel[j]) > fitness(&pixel[j - 1]) {
+        while j > 0 && fitness[j] > fitness[j - 1] {
             pixel.swap(j, j - 1);
+            fitness.swap(j, j - 1);
             j -= 1;
         }
     }

@@ -40,6 +40,9 @@ const CLIP: f32 = 0.2;
 /// defaults); a `describe_at` far beyond the coarsest level has its window cut to this.
 pub(crate) const MAX_DESCRIPTOR_RADIUS: usize = 96;
 
+/// Samples in a row of the window at most.
+const ROW_SAMPLES: usize = 2 * MAX_DESCRIPTOR_RADIUS + 1;
+
 /// A 128-value SIFT descriptor, unit length (or all zero where the window has no gradient).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SiftDescriptor(pub [f32; DESCRIPTOR_LEN]);
@@ -84,7 +87,7 @@ pub(crate) fn describe(
     // Gaussian of σ = d/2 cells, separable since the rotation keeps distances.
     let exp_scale = -1.0 / (0.5 * d * d * cell_width * cell_width);
     let gaussian = |offset: f32| (offset * offset * exp_scale).exp();
-    let mut column_weights = [0f32; 2 * MAX_DESCRIPTOR_RADIUS + 1];
+    let mut column_weights = [0f32; ROW_SAMPLES];
     for x in cols.clone() {
         column_weights[(x - cols.start()) as usize] = gaussian((x - col) as f32 - frac_x);
     }
@@ -96,6 +99,7 @@ pub(crate) fn describe(
     let bins_per_radian = DIRECTION_BINS as f32 / TAU;
     let centre = d / 2.0 - 0.5;
     let mut hist = CellHistograms::default();
+    let mut spread = RowSpread::default();
     let mut samples = 0usize;
     for y in rows {
         let dy = (y - row) as f32 - frac_y;
@@ -105,22 +109,197 @@ pub(crate) fn describe(
         let (row_lo, row_hi) = inside(-sin_t, dy * cos_t + centre, d);
         let first = (col as f32 + frac_x + col_lo.max(row_lo)).floor() as i64 - 1;
         let last = (col as f32 + frac_x + col_hi.min(row_hi)).ceil() as i64 + 1;
-        let start = y as usize * width;
-        for x in first.max(*cols.start())..=last.min(*cols.end()) {
-            let dx = (x - col) as f32 - frac_x;
-            let col_bin = dx * cos_t + dy * sin_t + centre;
-            let row_bin = -dx * sin_t + dy * cos_t + centre;
-            if !(row_bin > -1.0 && row_bin < d && col_bin > -1.0 && col_bin < d) {
-                continue;
-            }
-            samples += 1;
-            let i = start + x as usize;
-            let weight = row_weight * column_weights[(x - cols.start()) as usize];
-            let dir_bin = (orientation - direction.as_slice()[i]) * bins_per_radian;
-            hist.add(row_bin, col_bin, dir_bin, weight * magnitude.as_slice()[i]);
+        let (first, last) = (first.max(*cols.start()), last.min(*cols.end()));
+        if first > last {
+            continue;
         }
+        let start = y as usize * width;
+        let span = first as usize..last as usize + 1;
+        let sample = RowSample {
+            dx0: (first - col) as f32 - frac_x,
+            dy,
+            cos_t,
+            sin_t,
+            centre,
+            row_weight,
+            orientation,
+            bins_per_radian,
+        };
+        spread.fill(
+            &sample,
+            &column_weights[(first - cols.start()) as usize..][..span.len()],
+            &direction.as_slice()[start..][span.clone()],
+            &magnitude.as_slice()[start..][span],
+        );
+        samples += spread.add_to(&mut hist);
     }
     (samples > 0).then(|| hist.normalised())
+}
+
+/// What every sample of one row of the window shares: the first sample's offset `dx0` from
+/// the keypoint (the others follow one px apart), the row's offset `dy` and weight, and the
+/// window's rotation (`cos_t`, `sin_t` per cell width), centre and orientation.
+struct RowSample {
+    dx0: f32,
+    dy: f32,
+    cos_t: f32,
+    sin_t: f32,
+    centre: f32,
+    row_weight: f32,
+    orientation: f32,
+    bins_per_radian: f32,
+}
+
+/// One row's samples spread over the histograms' bins, in two passes: first each sample's
+/// first bin and its eight trilinear shares (a loop without dependencies, which the compiler
+/// vectorises), then the shares added in the samples' order (the same sums, bit for bit, as
+/// adding each sample as it is computed).
+struct RowSpread {
+    len: usize,
+    /// Per sample: inside the rotated window (its cell coordinates in `(−1, GRID)`).
+    inside: [bool; ROW_SAMPLES],
+    /// Per sample: the index of its first bin (row cell, column cell, direction bin).
+    base: [u32; ROW_SAMPLES],
+    /// Per share `j`, per sample: its share of the bin `base + SHARE_OFFSETS[j]`.
+    shares: [[f32; ROW_SAMPLES]; 8],
+}
+
+impl Default for RowSpread {
+    fn default() -> Self {
+        Self {
+            len: 0,
+            inside: [false; ROW_SAMPLES],
+            base: [0; ROW_SAMPLES],
+            shares: [[0.0; ROW_SAMPLES]; 8],
+        }
+    }
+}
+
+/// Bins of one column cell of the accumulator (the direction bins and two wrap-around).
+const STRIDE_C: usize = DIRECTION_BINS + 2;
+/// Bins of one row cell of the accumulator (its column cells and two margin cells).
+const STRIDE_R: usize = (GRID + 2) * STRIDE_C;
+/// The eight bins of a trilinear spread, from its first: (row cell, column cell, direction
+/// bin) each this one or the next.
+const SHARE_OFFSETS: [usize; 8] = [
+    0,
+    1,
+    STRIDE_C,
+    STRIDE_C + 1,
+    STRIDE_R,
+    STRIDE_R + 1,
+    STRIDE_R + STRIDE_C,
+    STRIDE_R + STRIDE_C + 1,
+];
+
+/// Per sample of a row: [`RowSpread::fill`]'s body.
+#[inline(always)]
+fn fill_row(
+    row: &RowSample,
+    weights: &[f32],
+    direction: &[f32],
+    magnitude: &[f32],
+    inside: &mut [bool; ROW_SAMPLES],
+    base: &mut [u32; ROW_SAMPLES],
+    shares: &mut [[f32; ROW_SAMPLES]; 8],
+) {
+    let d = GRID as f32;
+    let len = weights.len().min(direction.len()).min(magnitude.len());
+    for k in 0..len {
+        let dx = row.dx0 + k as f32;
+        let col_bin = dx * row.cos_t + row.dy * row.sin_t + row.centre;
+        let row_bin = -dx * row.sin_t + row.dy * row.cos_t + row.centre;
+        inside[k] = row_bin > -1.0 && row_bin < d && col_bin > -1.0 && col_bin < d;
+        let weight = row.row_weight * weights[k];
+        let dir_bin = (row.orientation - direction[k]) * row.bins_per_radian;
+        let value = weight * magnitude[k];
+        let (first, spread) = trilinear(row_bin, col_bin, dir_bin, value);
+        base[k] = first;
+        for (shares, share) in shares.iter_mut().zip(spread) {
+            shares[k] = share;
+        }
+    }
+}
+
+sillage_core::multiversion! {
+    /// [`fill_row`] on the widest SIMD the CPU offers.
+    fn fill_widest(row: &RowSample, weights: &[f32], direction: &[f32], magnitude: &[f32], inside: &mut [bool; ROW_SAMPLES], base: &mut [u32; ROW_SAMPLES], shares: &mut [[f32; ROW_SAMPLES]; 8]) => fill_row
+}
+
+/// A sample's trilinear spread over the 8 nearest `(row cell, column cell, direction bin)`:
+/// the index of the first bin and the shares of `value` of the bins `SHARE_OFFSETS` from it.
+/// Cell coordinates in `(−1, GRID)`, direction bin in `(−DIRECTION_BINS, DIRECTION_BINS)`
+/// (floors by truncating positive values: no libm call on the baseline x86-64 target).
+#[inline(always)]
+fn trilinear(row_bin: f32, col_bin: f32, dir_bin: f32, value: f32) -> (u32, [f32; 8]) {
+    let n = DIRECTION_BINS as i32;
+    // For a coordinate just below GRID, `x + 1` may round up to GRID + 1 (the f32 spacing
+    // doubles at GRID): the clamp keeps such a sample on the last cell and the margin.
+    let r1 = truncate_within(row_bin + 1.0, GRID as f32);
+    let c1 = truncate_within(col_bin + 1.0, GRID as f32);
+    let o0 = truncate_within(dir_bin + n as f32, 2.0 * n as f32) - n;
+    let (fr, fc, fo) = (
+        row_bin + 1.0 - r1 as f32,
+        col_bin + 1.0 - c1 as f32,
+        dir_bin - o0 as f32,
+    );
+    let o0 = o0.rem_euclid(n);
+    let base = (r1 as usize * STRIDE_R + c1 as usize * STRIDE_C + o0 as usize) as u32;
+    let v_r1 = value * fr;
+    let v_r0 = value - v_r1;
+    let (v_r0c1, v_r1c1) = (v_r0 * fc, v_r1 * fc);
+    let (v_r0c0, v_r1c0) = (v_r0 - v_r0c1, v_r1 - v_r1c1);
+    let mut shares = [0.0; 8];
+    for (c, v) in [v_r0c0, v_r0c1, v_r1c0, v_r1c1].into_iter().enumerate() {
+        let v1 = v * fo;
+        (shares[2 * c], shares[2 * c + 1]) = (v - v1, v1);
+    }
+    (base, shares)
+}
+
+/// `x` truncated towards zero, held within `[0, high]` (NaN gives 0): `(x as i32).clamp(0,
+/// high)` in a form that vectorises (a saturating cast does not).
+#[inline(always)]
+fn truncate_within(x: f32, high: f32) -> i32 {
+    let held = x.max(0.0).min(high);
+    // SAFETY: `held` is finite and within [0, high], and `high` (at most 16 here) fits an
+    // i32. `max` returns 0 for a NaN `x`.
+    unsafe { held.to_int_unchecked() }
+}
+
+impl RowSpread {
+    /// Computes the bins and shares of the samples of one row: `weights` the column
+    /// Gaussian's, `direction` and `magnitude` the gradient's, one value per sample.
+    fn fill(&mut self, row: &RowSample, weights: &[f32], direction: &[f32], magnitude: &[f32]) {
+        let len = weights.len();
+        self.len = len;
+        fill_widest(
+            row,
+            weights,
+            direction,
+            magnitude,
+            &mut self.inside,
+            &mut self.base,
+            &mut self.shares,
+        );
+    }
+
+    /// Adds the shares of the samples inside the window to `hist`, in order; the number of
+    /// them.
+    fn add_to(&self, hist: &mut CellHistograms) -> usize {
+        let mut added = 0;
+        for k in 0..self.len {
+            if !self.inside[k] {
+                continue;
+            }
+            added += 1;
+            let base = self.base[k] as usize;
+            for (offset, shares) in SHARE_OFFSETS.iter().zip(&self.shares) {
+                hist.0[base + offset] += shares[k];
+            }
+        }
+        added
+    }
 }
 
 /// The offsets `t` with `slope · t + intercept` in `(−1, d)`, as `(lowest, highest)` (the
@@ -148,51 +327,13 @@ impl Default for CellHistograms {
 }
 
 impl CellHistograms {
-    /// Spreads `value` over the 8 nearest `(row cell, column cell, direction bin)` by
-    /// trilinear interpolation; cell coordinates in `(−1, GRID)`, direction bin in
-    /// `(−DIRECTION_BINS, DIRECTION_BINS)` (floors by truncating positive values: no libm
-    /// call on the baseline x86-64 target).
-    #[inline]
-    fn add(&mut self, row_bin: f32, col_bin: f32, dir_bin: f32, value: f32) {
-        let n = DIRECTION_BINS as i32;
-        // For a coordinate just below GRID, `x + 1` may round up to GRID + 1 (the f32 spacing
-        // doubles at GRID): the clamp keeps such a sample on the last cell and the margin.
-        let (r1, c1) = (
-            ((row_bin + 1.0) as usize).min(GRID),
-            ((col_bin + 1.0) as usize).min(GRID),
-        );
-        let o0 = (dir_bin + n as f32) as i32 - n;
-        let (fr, fc, fo) = (
-            row_bin + 1.0 - r1 as f32,
-            col_bin + 1.0 - c1 as f32,
-            dir_bin - o0 as f32,
-        );
-        let o0 = o0.rem_euclid(n) as usize;
-        let stride_c = DIRECTION_BINS + 2;
-        let stride_r = (GRID + 2) * stride_c;
-        let base = r1 * stride_r + c1 * stride_c + o0;
-        let v_r1 = value * fr;
-        let v_r0 = value - v_r1;
-        for (row_offset, v_r) in [(0, v_r0), (stride_r, v_r1)] {
-            let v_rc1 = v_r * fc;
-            let v_rc0 = v_r - v_rc1;
-            for (col_offset, v_rc) in [(0, v_rc0), (stride_c, v_rc1)] {
-                let v_rco1 = v_rc * fo;
-                let cell = base + row_offset + col_offset;
-                self.0[cell] += v_rc - v_rco1;
-                self.0[cell + 1] += v_rco1;
-            }
-        }
-    }
-
     /// Folds the wrap-around bins back, drops the margin cells, and applies Lowe's
     /// normalise–clip–normalise.
     fn normalised(mut self) -> SiftDescriptor {
         let mut out = [0f32; DESCRIPTOR_LEN];
-        let stride_c = DIRECTION_BINS + 2;
         for r in 0..GRID {
             for c in 0..GRID {
-                let cell = ((r + 1) * (GRID + 2) + c + 1) * stride_c;
+                let cell = ((r + 1) * (GRID + 2) + c + 1) * STRIDE_C;
                 self.0[cell] += self.0[cell + DIRECTION_BINS];
                 self.0[cell + 1] += self.0[cell + DIRECTION_BINS + 1];
                 let dst = (r * GRID + c) * DIRECTION_BINS;
@@ -217,8 +358,12 @@ mod tests {
     fn samples_at_the_window_edge_stay_in_the_accumulator() {
         let below = f32::from_bits((GRID as f32).to_bits() - 1);
         let mut hist = CellHistograms::default();
-        hist.add(below, below, 7.999_999, 1.0);
-        hist.add(-0.999_999_9, -0.999_999_9, -7.999_999, 1.0);
+        for (bin, dir_bin) in [(below, 7.999_999), (-0.999_999_9, -7.999_999)] {
+            let (base, shares) = trilinear(bin, bin, dir_bin, 1.0);
+            for (offset, share) in SHARE_OFFSETS.iter().zip(shares) {
+                hist.0[base as usize + offset] += share;
+            }
+        }
         let total: f32 = hist.0.iter().sum();
         assert!((total - 2.0).abs() < 1e-5, "{total}");
     }
