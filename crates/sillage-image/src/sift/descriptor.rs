@@ -116,7 +116,8 @@ pub(crate) fn describe(
         let start = y as usize * width;
         let span = first as usize..last as usize + 1;
         let sample = RowSample {
-            dx0: (first - col) as f32 - frac_x,
+            first_offset: (first - col) as i32,
+            frac_x,
             dy,
             cos_t,
             sin_t,
@@ -136,11 +137,13 @@ pub(crate) fn describe(
     (samples > 0).then(|| hist.normalised())
 }
 
-/// What every sample of one row of the window shares: the first sample's offset `dx0` from
-/// the keypoint (the others follow one px apart), the row's offset `dy` and weight, and the
-/// window's rotation (`cos_t`, `sin_t` per cell width), centre and orientation.
+/// What every sample of one row of the window shares: the first sample's column from the
+/// keypoint's rounded column (the others follow one px apart) and the keypoint's fraction
+/// of a px, the row's offset `dy` and weight, and the window's rotation (`cos_t`, `sin_t`
+/// per cell width), centre and orientation.
 struct RowSample {
-    dx0: f32,
+    first_offset: i32,
+    frac_x: f32,
     dy: f32,
     cos_t: f32,
     sin_t: f32,
@@ -206,7 +209,7 @@ fn fill_row(
     let d = GRID as f32;
     let len = weights.len().min(direction.len()).min(magnitude.len());
     for k in 0..len {
-        let dx = row.dx0 + k as f32;
+        let dx = (row.first_offset + k as i32) as f32 - row.frac_x;
         let col_bin = dx * row.cos_t + row.dy * row.sin_t + row.centre;
         let row_bin = -dx * row.sin_t + row.dy * row.cos_t + row.centre;
         inside[k] = row_bin > -1.0 && row_bin < d && col_bin > -1.0 && col_bin < d;
@@ -353,6 +356,92 @@ impl CellHistograms {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`describe`] one sample at a time, each spread over its bins as it is computed.
+    fn describe_one_sample_at_a_time(
+        magnitude: &GrayImage,
+        direction: &GrayImage,
+        (x, y): (f32, f32),
+        scale: f32,
+        orientation: f32,
+    ) -> SiftDescriptor {
+        let (width, height) = magnitude.dimensions();
+        let d = GRID as f32;
+        let cell_width = CELL_SCALES * scale;
+        let radius = ((cell_width * SQRT_2 * (d + 1.0) * 0.5).round() as i64)
+            .clamp(0, MAX_DESCRIPTOR_RADIUS as i64);
+        let (col, row) = (x.round() as i64, y.round() as i64);
+        let (frac_x, frac_y) = (x - col as f32, y - row as f32);
+        let exp_scale = -1.0 / (0.5 * d * d * cell_width * cell_width);
+        let gaussian = |offset: f32| (offset * offset * exp_scale).exp();
+        let orientation = orientation.rem_euclid(TAU);
+        let (cos_t, sin_t) = (
+            orientation.cos() / cell_width,
+            orientation.sin() / cell_width,
+        );
+        let centre = d / 2.0 - 0.5;
+        let mut hist = CellHistograms::default();
+        for y in (row - radius).max(1)..=(row + radius).min(height as i64 - 2) {
+            let dy = (y - row) as f32 - frac_y;
+            for x in (col - radius).max(1)..=(col + radius).min(width as i64 - 2) {
+                let dx = (x - col) as f32 - frac_x;
+                let col_bin = dx * cos_t + dy * sin_t + centre;
+                let row_bin = -dx * sin_t + dy * cos_t + centre;
+                if !(row_bin > -1.0 && row_bin < d && col_bin > -1.0 && col_bin < d) {
+                    continue;
+                }
+                let i = y as usize * width + x as usize;
+                let weight = gaussian(dy) * gaussian(dx);
+                let dir_bin =
+                    (orientation - direction.as_slice()[i]) * (DIRECTION_BINS as f32 / TAU);
+                let value = weight * magnitude.as_slice()[i];
+                let (base, shares) = trilinear(row_bin, col_bin, dir_bin, value);
+                for (offset, share) in SHARE_OFFSETS.iter().zip(shares) {
+                    hist.0[base as usize + offset] += share;
+                }
+            }
+        }
+        hist.normalised()
+    }
+
+    #[test]
+    fn rows_in_two_passes_give_the_bits_of_one_sample_at_a_time() {
+        let (width, height) = (64, 48);
+        let texture = |k: usize, a: f32| ((k * 7919 % 1013) as f32 * a).sin();
+        let magnitude: Vec<f32> = (0..width * height)
+            .map(|k| texture(k, 0.37).abs())
+            .collect();
+        let direction: Vec<f32> = (0..width * height)
+            .map(|k| 3.1 * texture(k, 0.11))
+            .collect();
+        let magnitude = GrayImage::from_vec(width, height, magnitude).unwrap();
+        let direction = GrayImage::from_vec(width, height, direction).unwrap();
+        // Inside, astride the edges and the corner; scales and orientations of every kind.
+        let positions = [
+            (31.3, 22.8),
+            (2.6, 40.1),
+            (60.9, 3.4),
+            (0.2, 0.7),
+            (45.5, 46.5),
+        ];
+        for (p, &position) in positions.iter().enumerate() {
+            for (scale, orientation) in [(1.1, 0.0), (1.9, 1.3), (2.7, -2.2), (0.6, 6.0)] {
+                let orientation = orientation + p as f32 * 0.41;
+                let want = describe_one_sample_at_a_time(
+                    &magnitude,
+                    &direction,
+                    position,
+                    scale,
+                    orientation,
+                );
+                let (x, y) = position;
+                let got = describe(&magnitude, &direction, x, y, scale, orientation).unwrap();
+                for (a, b) in got.0.iter().zip(want.0) {
+                    assert_eq!(a.to_bits(), b.to_bits(), "at {position:?}, scale {scale}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn samples_at_the_window_edge_stay_in_the_accumulator() {
